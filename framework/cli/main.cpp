@@ -1,0 +1,104 @@
+/// \file
+/// `skinlab`: the one command-line entry point. Subcommands parse their arguments and call
+/// library code; this is the only place where an exception becomes a message and an exit status.
+
+#include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "framework/core/config.hpp"
+#include "framework/core/environment.hpp"
+#include "framework/core/error.hpp"
+#include "framework/core/logging.hpp"
+#include "framework/core/registry.hpp"
+#include "framework/train/run_options.hpp"
+
+namespace {
+
+using namespace skinlab;
+
+int run_info(bool as_json) {
+  nlohmann::json registries = nlohmann::json::object();
+  for (const auto* registry : all_registries()) registries[registry->name()] = registry->keys();
+  const GitState git = git_state(source_dir());
+  if (as_json) {
+    nlohmann::json out = {{"version", SKINLAB_VERSION},
+                          {"git_commit", git.commit},
+                          {"git_dirty", git.dirty},
+                          {"libraries", library_versions()},
+                          {"threads", torch_threads()},
+                          {"registries", registries}};
+    std::cout << out.dump(2) << "\n";
+    return 0;
+  }
+  std::cout << "skinlab " << SKINLAB_VERSION << " (git " << git.commit.substr(0, 12)
+            << (git.dirty ? ", modified" : "") << ")\n";
+  std::cout << "source: " << source_dir().string() << "\n";
+  std::cout << "libraries:\n";
+  const nlohmann::json versions = library_versions();
+  for (const auto& [name, version] : versions.items()) {
+    std::cout << "  " << name << ": " << version.get<std::string>() << "\n";
+  }
+  std::cout << "threads: " << torch_threads() << "\n";
+  std::cout << "registries:\n";
+  for (const auto* registry : all_registries()) {
+    std::string keys;
+    for (const auto& k : registry->keys()) keys += (keys.empty() ? "" : ", ") + k;
+    std::cout << "  " << registry->name() << ": " << (keys.empty() ? "(none yet)" : keys) << "\n";
+  }
+  return 0;
+}
+
+int run_config(const std::string& file, const std::vector<std::string>& overrides) {
+  const config::Config config = config::Config::load(file, overrides);
+  train::RunOptions::from(config);  // validates every section before printing
+  std::cout << config.to_yaml();
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"skinlab: learned character skinning (HeterSkinNet and baselines)"};
+  app.require_subcommand(1);
+  std::string log_level = "info";
+  app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off")
+      ->capture_default_str();
+  int threads = 0;
+  app.add_option("--threads", threads, "libtorch threads; 0 = every hardware thread")
+      ->capture_default_str();
+
+  auto* info = app.add_subcommand("info", "versions, threads and every registry with its keys");
+  bool info_json = false;
+  info->add_flag("--json", info_json, "print as JSON");
+
+  auto* config_cmd = app.add_subcommand(
+      "config", "print the fully resolved config (bases merged, overrides applied, validated)");
+  std::string config_file;
+  std::vector<std::string> overrides;
+  config_cmd->add_option("file", config_file, "experiment config (YAML)")->required();
+  config_cmd->add_option("overrides", overrides, "key.sub=value assignments, applied in order");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+
+  try {
+    logging::init(log_level);
+    verify_registries();
+    set_torch_threads(threads);
+    if (*info) return run_info(info_json);
+    if (*config_cmd) return run_config(config_file, overrides);
+  } catch (const std::exception& e) {
+    std::fflush(stdout);
+    std::cerr << "skinlab: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

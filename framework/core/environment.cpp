@@ -1,0 +1,112 @@
+#include "framework/core/environment.hpp"
+
+#include <ATen/Parallel.h>
+#include <CGAL/version.h>
+#include <H5public.h>
+#include <fmt/core.h>
+#include <spdlog/version.h>
+#include <torch/version.h>
+#include <unistd.h>
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdio>
+#include <ctime>
+#include <memory>
+#include <thread>
+
+#include "framework/core/error.hpp"
+
+#ifndef SKINLAB_SOURCE_DIR
+#error "SKINLAB_SOURCE_DIR must be defined by the build"
+#endif
+#ifndef SKINLAB_BUILD_TYPE
+#define SKINLAB_BUILD_TYPE "unknown"
+#endif
+
+namespace skinlab {
+
+namespace {
+
+/// Runs a shell command and returns its stdout, or nullopt-like empty + ok=false on failure.
+bool run_capture(const std::string& command, std::string& out) {
+  std::unique_ptr<FILE, int (*)(FILE*)> pipe(::popen(command.c_str(), "r"), ::pclose);
+  if (!pipe) return false;
+  std::array<char, 512> buffer{};
+  out.clear();
+  while (std::fgets(buffer.data(), buffer.size(), pipe.get()) != nullptr) out += buffer.data();
+  return ::pclose(pipe.release()) == 0;
+}
+
+std::string quote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += (c == '\'') ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+}  // namespace
+
+std::filesystem::path source_dir() { return SKINLAB_SOURCE_DIR; }
+
+GitState git_state(const std::filesystem::path& dir) {
+  GitState state;
+  std::string out;
+  const std::string git = "git -C " + quote(dir.string());
+  if (run_capture(git + " rev-parse HEAD 2>/dev/null", out) && out.size() >= 40) {
+    state.commit = out.substr(0, 40);
+    if (run_capture(git + " status --porcelain --untracked-files=no 2>/dev/null", out)) {
+      state.dirty = !out.empty();
+    }
+  }
+  return state;
+}
+
+nlohmann::json library_versions() {
+  return {
+      {"compiler", "g++ " __VERSION__},
+      {"libtorch", TORCH_VERSION},
+      {"eigen", fmt::format("{}.{}.{}", EIGEN_WORLD_VERSION, EIGEN_MAJOR_VERSION,
+                            EIGEN_MINOR_VERSION)},
+      {"cgal", CGAL_VERSION_STR},
+      {"hdf5", fmt::format("{}.{}.{}", H5_VERS_MAJOR, H5_VERS_MINOR, H5_VERS_RELEASE)},
+      {"fmt", fmt::format("{}.{}.{}", FMT_VERSION / 10000, FMT_VERSION / 100 % 100,
+                          FMT_VERSION % 100)},
+      {"spdlog", fmt::format("{}.{}.{}", SPDLOG_VER_MAJOR, SPDLOG_VER_MINOR, SPDLOG_VER_PATCH)},
+      {"nlohmann_json", fmt::format("{}.{}.{}", NLOHMANN_JSON_VERSION_MAJOR,
+                                    NLOHMANN_JSON_VERSION_MINOR, NLOHMANN_JSON_VERSION_PATCH)},
+  };
+}
+
+int torch_threads() { return at::get_num_threads(); }
+
+int set_torch_threads(int n) {
+  if (n < 0) throw Error("thread count must be >= 0 (0 = every hardware thread), got " + std::to_string(n));
+  const int hardware = static_cast<int>(std::thread::hardware_concurrency());
+  at::set_num_threads(n > 0 ? n : std::max(1, hardware));
+  return at::get_num_threads();
+}
+
+nlohmann::json collect_environment(std::uint64_t seed, const std::vector<std::string>& command) {
+  const GitState git = git_state(source_dir());
+  std::array<char, 256> host{};
+  if (::gethostname(host.data(), host.size() - 1) != 0) host[0] = '\0';
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  ::gmtime_r(&now, &utc);
+  std::array<char, 32> time_text{};
+  std::strftime(time_text.data(), time_text.size(), "%Y-%m-%dT%H:%M:%SZ", &utc);
+  return {
+      {"git_commit", git.commit},
+      {"git_dirty", git.dirty},
+      {"build_type", SKINLAB_BUILD_TYPE},
+      {"libraries", library_versions()},
+      {"threads", torch_threads()},
+      {"hardware_threads", static_cast<int>(::sysconf(_SC_NPROCESSORS_ONLN))},
+      {"seed", seed},
+      {"host", host.data()},
+      {"time_utc", time_text.data()},
+      {"command", command},
+  };
+}
+
+}  // namespace skinlab

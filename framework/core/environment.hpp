@@ -1,0 +1,44 @@
+#pragma once
+/// \file
+/// What a run records about the machine and the code it ran on (`env.json`), and what
+/// `skinlab info` prints.
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace skinlab {
+
+/// Commit of a git work tree and whether tracked files differ from it.
+struct GitState {
+  std::string commit = "unknown";  ///< full SHA, or "unknown" outside a work tree / without git
+  bool dirty = false;              ///< tracked files modified (untracked files do not count)
+};
+
+/// Reads the git state of `dir` by running `git` (no network).
+GitState git_state(const std::filesystem::path& dir);
+
+/// Versions of the compiler and of every library that can change a result:
+/// {"compiler", "libtorch", "eigen", "cgal", "hdf5", "yaml_cpp", "fmt", "spdlog", "json"}.
+nlohmann::json library_versions();
+
+/// Number of intra-op threads libtorch uses.
+int torch_threads();
+
+/// Sets libtorch's intra-op threads: `n`, or every hardware thread when `n` is 0. (OpenMP's own
+/// default is not reliable in containers: on our 2-core CI machine it picks 1.) Returns the
+/// count in effect.
+int set_torch_threads(int n);
+
+/// The `env.json` record of a run: git commit and dirty flag of the source tree, compiler,
+/// library versions, build type, thread count, seed, host name, time (UTC, ISO 8601) and the
+/// command line.
+nlohmann::json collect_environment(std::uint64_t seed, const std::vector<std::string>& command);
+
+/// The source tree this binary was built from.
+std::filesystem::path source_dir();
+
+}  // namespace skinlab

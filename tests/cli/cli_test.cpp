@@ -1,0 +1,103 @@
+// The `skinlab` binary, run as a user runs it: exit status, stdout and stderr.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "framework/core/atomic_file.hpp"
+#include "tests/test_util.hpp"
+
+namespace skinlab {
+namespace {
+
+using testing::TempDir;
+
+struct Result {
+  int status;
+  std::string out;
+  std::string err;
+};
+
+Result run(const std::string& args) {
+  TempDir dir;
+  const auto err_file = dir / "stderr.txt";
+  const std::string command = std::string("cd '") + SKINLAB_SOURCE_DIR + "' && '" + SKINLAB_CLI +
+                              "' " + args + " 2>'" + err_file.string() + "'";
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (pipe == nullptr) throw std::runtime_error("popen failed");
+  std::string out;
+  std::array<char, 4096> buffer{};
+  while (std::fgets(buffer.data(), buffer.size(), pipe) != nullptr) out += buffer.data();
+  const int status = ::pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out, read_file(err_file)};
+}
+
+TEST(Cli, InfoListsEveryRegistry) {
+  const Result r = run("info");
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* line : {"distance:", "graph_op:", "model:", "metric:", "dataset:",
+                           "loss: kl, laplacian_smoothing, mse, soft_cross_entropy", "libtorch:"}) {
+    EXPECT_NE(r.out.find(line), std::string::npos) << line << "\n" << r.out;
+  }
+  const Result j = run("info --json");
+  ASSERT_EQ(j.status, 0) << j.err;
+  const auto info = nlohmann::json::parse(j.out);
+  EXPECT_EQ(info["registries"]["loss"].size(), 4u);
+  EXPECT_TRUE(info["registries"].contains("dataset"));
+}
+
+TEST(Cli, ConfigPrintsTheMergedResultWithOverrides) {
+  const Result r = run("config configs/ablations/wo_smoothing.yaml seed=3 losses.0.weight=2");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("seed: 3"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("results_dir: results"), std::string::npos) << r.out;  // from base.yaml
+  EXPECT_NE(r.out.find("experiment: heterskinnet_wo_smoothing"), std::string::npos);
+  EXPECT_NE(r.out.find("weight: 2"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("laplacian_smoothing"), std::string::npos) << "list must be replaced";
+  EXPECT_EQ(r.out.find("_base_"), std::string::npos);
+}
+
+TEST(Cli, UnknownFieldIsReportedWithFileLineAndKey) {
+  TempDir dir;
+  const auto file = dir.write("bad.yaml", "_base_: " + std::string(SKINLAB_SOURCE_DIR) +
+                                              "/configs/heterskinnet.yaml\nsede: 3\n");
+  const Result r = run("config " + file.string());
+  EXPECT_EQ(r.status, 1);
+  EXPECT_TRUE(r.out.empty()) << "nothing printed on error";
+  EXPECT_NE(r.err.find("skinlab: error: " + file.string() + ":2: sede: unknown field"),
+            std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("did you mean 'seed'?"), std::string::npos) << r.err;
+}
+
+TEST(Cli, UnknownTypeListsTheKnownTypes) {
+  const Result r = run("config configs/heterskinnet.yaml losses.1.type=laplacian");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("losses[1]: unknown loss type 'laplacian'; known loss types: kl, "
+                       "laplacian_smoothing, mse, soft_cross_entropy"),
+            std::string::npos) << r.err;
+  const Result m = run("config configs/heterskinnet.yaml model.type=heterskinnet");
+  EXPECT_EQ(m.status, 1);
+  EXPECT_NE(m.err.find("override 'model.type=heterskinnet'"), std::string::npos) << m.err;
+  EXPECT_NE(m.err.find("unknown model type 'heterskinnet'"), std::string::npos) << m.err;
+}
+
+TEST(Cli, WrongTypeMissingFileAndBadUsage) {
+  const Result t = run("config configs/heterskinnet.yaml seed=abc");
+  EXPECT_EQ(t.status, 1);
+  EXPECT_NE(t.err.find("seed: expected an integer, got 'abc'"), std::string::npos) << t.err;
+  const Result f = run("config configs/does_not_exist.yaml");
+  EXPECT_EQ(f.status, 1);
+  EXPECT_NE(f.err.find("configs/does_not_exist.yaml: config file does not exist"),
+            std::string::npos) << f.err;
+  const Result u = run("");
+  EXPECT_NE(u.status, 0);
+  const Result l = run("--log-level loud info");
+  EXPECT_EQ(l.status, 1);
+  EXPECT_NE(l.err.find("unknown log level 'loud'"), std::string::npos) << l.err;
+}
+
+}  // namespace
+}  // namespace skinlab
