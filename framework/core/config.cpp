@@ -425,56 +425,42 @@ void Config::apply_override(const std::string& assignment) {
   tree->origins = tree_->origins;
   tree->source = tree_->source;
 
+  const std::string source = "override '" + assignment + "'";
   YAML::Node cur;
   cur.reset(tree->root);
   std::string path;
-  for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
+  for (std::size_t i = 0; i < parts.size(); ++i) {
     const std::string& part = parts[i];
-    std::size_t index = 0;
+    const bool last = i + 1 == parts.size();
+    YAML::Node slot;
     if (cur.IsSequence()) {
+      std::size_t index = 0;
       if (!parse_index(part, index) || index >= cur.size()) {
-        throw ConfigError("override '" + assignment + "': '" + path + "' is a list of " +
-                          std::to_string(cur.size()) + " entries; '" + part +
-                          "' is not a valid index");
+        throw ConfigError(source + ": '" + path + "' is a list of " + std::to_string(cur.size()) +
+                          " entries; '" + part + "' is not a valid index");
       }
       path = index_path(path, index);
-      YAML::Node next = cur[index];
-      cur.reset(next);
-      continue;
+      slot.reset(cur[index]);
+    } else if (cur.IsScalar()) {
+      throw ConfigError(source + ": '" + path + "' is a value, not a map; cannot set a key under it");
+    } else {
+      path = child_path(path, part);
+      const YAML::Node& ccur = cur;
+      if (!last && (!ccur[part].IsDefined() || ccur[part].IsNull())) {
+        cur[part] = YAML::Node(YAML::NodeType::Map);  // intermediate maps are created
+        tree->origins[path] = Origin{source, 0};
+      }
+      slot.reset(cur[part]);
     }
-    if (cur.IsScalar()) {
-      throw ConfigError("override '" + assignment + "': '" + path +
-                        "' is a value, not a map; cannot set a key under it");
+    if (last) {
+      slot = value;  // writes through into the tree
+    } else {
+      cur.reset(slot);
     }
-    path = child_path(path, part);
-    const YAML::Node& ccur = cur;
-    if (!ccur[part].IsDefined() || ccur[part].IsNull()) {
-      cur[part] = YAML::Node(YAML::NodeType::Map);
-      tree->origins[path] = Origin{"override '" + assignment + "'", 0};
-    }
-    YAML::Node next = cur[part];
-    cur.reset(next);
-  }
-  const std::string& last = parts.back();
-  std::size_t index = 0;
-  if (cur.IsSequence()) {
-    if (!parse_index(last, index) || index >= cur.size()) {
-      throw ConfigError("override '" + assignment + "': '" + path + "' is a list of " +
-                        std::to_string(cur.size()) + " entries; '" + last +
-                        "' is not a valid index");
-    }
-    path = index_path(path, index);
-    cur[index] = value;
-  } else if (cur.IsScalar()) {
-    throw ConfigError("override '" + assignment + "': '" + path +
-                      "' is a value, not a map; cannot set a key under it");
-  } else {
-    path = child_path(path, last);
-    cur[last] = value;
   }
   erase_under(tree->origins, path);
   Origins value_origins;
-  record_origins(value, path, "override '" + assignment + "'", value_origins);
+  record_origins(value, path, source, value_origins);
   for (auto& [p, o] : value_origins) {
     o.line = 0;
     tree->origins[p] = o;
