@@ -9,22 +9,17 @@
 namespace skinlab::geometry {
 namespace {
 
-// Edge weights (i < j) of every triangle edge, duplicates summed later by setFromTriplets.
+// One entry (i < j) per face edge; an edge of several faces is summed by setFromTriplets and
+// counted once when L is assembled, which is cheaper than sorting the edges here.
 std::vector<Eigen::Triplet<double>> uniform_weights(const Mesh& mesh) {
-  std::vector<std::pair<int, int>> edges;
-  edges.reserve(static_cast<size_t>(3 * mesh.F.rows()));
+  std::vector<Eigen::Triplet<double>> w;
+  w.reserve(static_cast<size_t>(3 * mesh.F.rows()));
   for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
     for (int k = 0; k < 3; ++k) {
       const int a = mesh.F(f, k), b = mesh.F(f, (k + 1) % 3);
-      if (a != b) edges.emplace_back(std::min(a, b), std::max(a, b));
+      if (a != b) w.emplace_back(std::min(a, b), std::max(a, b), 1.0);
     }
   }
-  // An edge shared by two (or more, non-manifold) faces still weighs 1.
-  std::sort(edges.begin(), edges.end());
-  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-  std::vector<Eigen::Triplet<double>> w;
-  w.reserve(edges.size());
-  for (const auto& [a, b] : edges) w.emplace_back(a, b, 1.0);
   return w;
 }
 
@@ -70,7 +65,10 @@ Eigen::SparseMatrix<double> laplacian(const Mesh& mesh, const LaplacianOptions& 
   Eigen::VectorXd degree = Eigen::VectorXd::Zero(n);
   for (int i = 0; i < n; ++i) {
     for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(A, i); it; ++it) {
-      const double a = (cot && options.clamp_negative) ? std::max(0.0, it.value()) : it.value();
+      // Uniform: an edge weighs 1 however many (non-manifold) faces share it.
+      const double a = !cot                    ? 1.0
+                       : options.clamp_negative ? std::max(0.0, it.value())
+                                                : it.value();
       if (a == 0) continue;
       const int j = static_cast<int>(it.col());
       entries.emplace_back(i, j, -a);
