@@ -23,9 +23,8 @@ struct MergeOptions {
 
 struct MergedMesh {
   Mesh mesh;  ///< #V_new×3 positions, #F_new×3 faces (faces that became degenerate are dropped)
-  /// #V_old: new vertex index of every input vertex. New vertices are numbered in order of first
-  /// occurrence, so old_to_new is non-decreasing on first occurrences and the result depends only
-  /// on the input order.
+  /// #V_old: new vertex index of every input vertex. New vertex n is the n-th distinct position
+  /// met in input order, so the result depends only on the input order, never on hashing.
   Eigen::VectorXi old_to_new;
   /// #F_new: index into the input F of every kept face (input order is preserved).
   Eigen::VectorXi kept_faces;
