@@ -20,8 +20,7 @@
 /// B(bone) and G(bone node) agree when the file's node hierarchy is stored in the bind pose; the
 /// largest disagreement is measured and returned in ImportReport (and logged as a warning above
 /// ImportOptions::bind_pose_tolerance). On Minetest's character.b3d (mesh node "Player" at the
-/// identity) they agree to 1.3e-8 file units (float round-off) for all 6 bones, rotations
-/// included.
+/// identity) the positions agree to 1.3e-8 file units (float round-off) for all 6 bones.
 ///
 /// Skeleton. The joints are the nodes named by aiBones (of every mesh) plus their ancestors up
 /// to the lowest common ancestor (LCA) of all bone nodes, which is the single root. Nodes above
@@ -61,6 +60,10 @@
 /// weights (end joints) stay joints; AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS = false, so that FBX
 /// pivots are folded into the bone node instead of creating "$AssimpFbx$" helper nodes between
 /// bones.
+///
+/// Importer behaviour seen in the tests: assimp 5.2's glTF2 and COLLADA importers drop weights
+/// ≤ 0, and glTF2 drops JOINTS_0 indices beyond the skin's joint list, before we see them; the
+/// vertex keeps its other weights and renormalisation scales them to sum 1.
 ///
 /// Format quirk (B3D): assimp's B3D importer converts the left-handed Blitz3D data to its
 /// right-handed convention by mirroring Z (MakeLeftHanded) and flipping the winding, so node

@@ -19,8 +19,8 @@ namespace skinlab::geometry {
 /// \param V  #V×3 rest (bind-pose) vertex positions
 /// \param W  #V×#J per-joint weights (rows normally sum to 1; not renormalised here)
 /// \param T  #J affine transforms, each relative to the bind pose (bind → posed, in the frame of
-///           V); Eigen::Affine3d holds the 4×4 matrix, a 3×4 [R|t] converts implicitly via
-///           Eigen::Affine3d(M) after setting .matrix().topRows<3>()
+///           V); an Eigen::Affine3d is the 4×4 matrix, and a 3×4 [R|t] is its top three rows
+///           (`T[j].matrix().topRows<3>() = M`)
 /// \return   #V×3 deformed positions, in the frame of V
 /// Throws GeometryError if W is not #V×#J or V is not #V×3.
 Eigen::MatrixXd lbs(const Eigen::MatrixXd& V, const SparseWeights& W,

@@ -6,7 +6,6 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
-#include <cstring>
 #include <string>
 #include <vector>
 

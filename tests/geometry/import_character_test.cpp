@@ -284,6 +284,93 @@ TEST(ImportCharacter, UnweightedVertexOutsideTheSkeletonIsAnError) {
                                                  "no bone weight"});
 }
 
+// A documented assimp 5.2 behaviour, not ours: a glTF JOINTS_0 index beyond the skin's joint
+// list is silently dropped by the glTF2 importer (as are weights ≤ 0), so the vertex keeps its
+// other weights, which renormalisation then scales to 1.
+TEST(ImportCharacter, GltfJointIndexBeyondTheSkinIsDroppedByAssimp) {
+  GltfScene s;
+  s.nodes = {R"({"name":"root","children":[1]})", R"({"name":"child","translation":[0,1,0]})",
+             R"({"name":"body","mesh":0,"skin":0})"};
+  s.roots = {0, 2};
+  GltfMesh m = strip("body", 0);
+  m.joints[3] = {0, 7, 0, 0};
+  s.meshes = {m};
+  s.skins = {GltfSkin{{0, 1}, {translation(0, 0, 0), translation(0, -1, 0)}}};
+  TempDir dir;
+  const Character c = import_character(dir.write("range.gltf", s.json()));
+  EXPECT_EQ(c.weights.coeff(3, 0), 1.0);
+  EXPECT_EQ(c.weights.coeff(3, 1), 0.0);
+}
+
+/// A COLLADA file: node "rig" (translated by +3 in z) holds the joint chain root → child and the
+/// skinned 2-triangle strip; `weights` is the 3-entry weight array (vertices 0..2 use entry 0 on
+/// root, root, child; vertex 3 uses entry 1 on root and entry 2 on child).
+std::string collada(const std::string& weights) {
+  return R"(<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit name="meter" meter="1"/><up_axis>Y_UP</up_axis></asset>
+  <library_geometries><geometry id="strip" name="strip"><mesh>
+    <source id="strip-pos"><float_array id="strip-pos-array" count="12">0 0 0 1 0 0 0 2 0 1 2 0</float_array>
+      <technique_common><accessor source="#strip-pos-array" count="4" stride="3">
+        <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/>
+      </accessor></technique_common></source>
+    <vertices id="strip-vtx"><input semantic="POSITION" source="#strip-pos"/></vertices>
+    <triangles count="2"><input semantic="VERTEX" source="#strip-vtx" offset="0"/><p>0 1 2 1 3 2</p></triangles>
+  </mesh></geometry></library_geometries>
+  <library_controllers><controller id="skin"><skin source="#strip">
+    <bind_shape_matrix>1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1</bind_shape_matrix>
+    <source id="skin-joints"><Name_array id="skin-joints-array" count="2">root child</Name_array>
+      <technique_common><accessor source="#skin-joints-array" count="2" stride="1">
+        <param name="JOINT" type="name"/></accessor></technique_common></source>
+    <source id="skin-bind"><float_array id="skin-bind-array" count="32">
+      1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1  1 0 0 0 0 1 0 -1 0 0 1 0 0 0 0 1</float_array>
+      <technique_common><accessor source="#skin-bind-array" count="2" stride="16">
+        <param name="TRANSFORM" type="float4x4"/></accessor></technique_common></source>
+    <source id="skin-weights"><float_array id="skin-weights-array" count="3">)" +
+         weights + R"(</float_array>
+      <technique_common><accessor source="#skin-weights-array" count="3" stride="1">
+        <param name="WEIGHT" type="float"/></accessor></technique_common></source>
+    <joints><input semantic="JOINT" source="#skin-joints"/>
+      <input semantic="INV_BIND_MATRIX" source="#skin-bind"/></joints>
+    <vertex_weights count="4"><input semantic="JOINT" source="#skin-joints" offset="0"/>
+      <input semantic="WEIGHT" source="#skin-weights" offset="1"/>
+      <vcount>1 1 1 2</vcount><v>0 0 0 0 1 0 0 1 1 2</v></vertex_weights>
+  </skin></controller></library_controllers>
+  <library_visual_scenes><visual_scene id="scene">
+    <node id="rig" name="rig"><translate>0 0 3</translate>
+      <node id="root" name="root" sid="root" type="JOINT">
+        <node id="child" name="child" sid="child" type="JOINT"><translate>0 1 0</translate></node>
+      </node>
+      <node id="body" name="body"><instance_controller url="#skin"><skeleton>#root</skeleton></instance_controller></node>
+    </node>
+  </visual_scene></library_visual_scenes>
+  <scene><instance_visual_scene url="#scene"/></scene>
+</COLLADA>
+)";
+}
+
+TEST(ImportCharacter, ColladaSkin) {
+  TempDir dir;
+  ImportReport report;
+  const Character c = import_character(dir.write("strip.dae", collada("1 0.25 0.75")), {}, &report);
+  ASSERT_EQ(c.skeleton.names, (std::vector<std::string>{"root", "child"}));
+  EXPECT_TRUE(row(c.skeleton.positions, 1).isApprox(Eigen::Vector3d(0, 1, 3), 1e-6));
+  EXPECT_TRUE(row(c.mesh.V, 3).isApprox(Eigen::Vector3d(1, 2, 3), 1e-6));
+  EXPECT_LT(report.max_bind_pose_mismatch, 1e-6);
+  EXPECT_NEAR(c.weights.coeff(3, 0), 0.25, 1e-7);
+  EXPECT_NEAR(c.weights.coeff(3, 1), 0.75, 1e-7);
+}
+
+// Also assimp's, not ours: its COLLADA importer drops weights ≤ 0 before we see them (so our
+// negative-weight check only guards importers that do not), and renormalisation turns the
+// remaining 1.5 into 1.
+TEST(ImportCharacter, ColladaNegativeWeightIsDroppedByAssimpAndTheRestRenormalised) {
+  TempDir dir;
+  const Character c = import_character(dir.write("negative.dae", collada("1 1.5 -0.5")));
+  EXPECT_EQ(c.weights.coeff(3, 0), 1.0);
+  EXPECT_EQ(c.weights.coeff(3, 1), 0.0);
+}
+
 TEST(ImportCharacter, NoBonesIsAnError) {
   GltfScene s;
   s.nodes = {R"({"name":"statue","mesh":0})"};
