@@ -1,15 +1,16 @@
 #pragma once
 /// \file
-/// Normalisation of a character as in RigNet's dataset (Xu et al., SIGGRAPH 2020, Sec. 6 and
+/// Normalisation of a character as in RigNet's dataset (Xu et al., SIGGRAPH 2020, and
 /// its quick_start/gen_dataset scripts): consistent orientation (Y up), scaled to unit height,
 /// centred. The applied similarity is returned so that predictions (joint positions,
 /// deformations) can be mapped back to the source frame and units.
 ///
 /// Convention (state it once, use it everywhere): after normalisation the mesh's axis-aligned
 /// bounding box has Y extent 1 (so a character authored in metres becomes 1 m tall), its centre
-/// in x and z is at 0, and its lowest point (the feet) is at y = 0. RigNet centres the bounding
-/// box in all three axes; we put the feet on the ground plane instead, which is what game
-/// engines and animation retargeting expect, and keep x/z centred as RigNet does.
+/// in x and z is at 0, and its lowest point (the feet) is at y = 0. RigNet's normalisation
+/// pivot, as we read its quick_start.py (normalize_obj), is the same point (x/z centre of the
+/// box, lowest y), but it divides by the largest box extent; we divide by the Y extent so that
+/// every character is exactly 1 tall whatever its arm span.
 
 #include <Eigen/Core>
 
