@@ -102,7 +102,7 @@ TEST(Registry, ExactKeysOfEveryCategory) {
   std::map<std::string, std::vector<std::string>> actual;
   for (const auto* registry : all_registries()) actual[registry->name()] = registry->keys();
   const std::map<std::string, std::vector<std::string>> expected = {
-      {"distance", {}},
+      {"distance", {"euclidean", "hollow_dist"}},
       {"graph_op", {}},
       {"model", {}},
       {"loss", {"kl", "laplacian_smoothing", "mse", "soft_cross_entropy"}},
