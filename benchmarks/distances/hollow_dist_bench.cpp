@@ -93,8 +93,8 @@ Character make_character(const Size& size) {
   for (int j = 1; j < size.sphere_v; ++j) {
     for (int i = 0; i < size.sphere_u; ++i) {
       const double u = 2 * M_PI * i / size.sphere_u, v = M_PI * j / size.sphere_v;
-      V.push_back(R * Eigen::Vector3d(std::sin(v) * std::cos(u), std::sin(v) * std::sin(u),
-                                      std::cos(v)));
+      V.push_back(
+          R * Eigen::Vector3d(std::sin(v) * std::cos(u), std::sin(v) * std::sin(u), std::cos(v)));
     }
   }
   const int south = static_cast<int>(V.size());
@@ -256,9 +256,15 @@ void BM_Euclidean(benchmark::State& state) {
 
 // range(0): character 0/1/2 = ~1K/20, ~3K/60, ~5K/100; range(1): threads.
 BENCHMARK(BM_Voxelize)->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_SearchAllBones)->ArgsProduct({{0, 1, 2}, {1, 2}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_SearchAllBones)
+    ->ArgsProduct({{0, 1, 2}, {1, 2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(BM_VertexDistances)->DenseRange(0, 2)->UseManualTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_HollowDistTotal)->ArgsProduct({{0, 1, 2}, {1, 2}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_HollowDistTotal)
+    ->ArgsProduct({{0, 1, 2}, {1, 2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(BM_Euclidean)->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
 
 }  // namespace
@@ -267,7 +273,8 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::AddCustomContext("hollow_dist_grid", "88^3 cube, margin 2 cells");
-  benchmark::AddCustomContext("characters", "helix tube + detached sphere: ~1K/20, ~3K/60, ~5K/100 (vertices/bones)");
+  benchmark::AddCustomContext(
+      "characters", "helix tube + detached sphere: ~1K/20, ~3K/60, ~5K/100 (vertices/bones)");
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;

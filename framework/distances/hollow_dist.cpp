@@ -5,8 +5,8 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <functional>
 #include <cmath>
+#include <functional>
 #include <limits>
 
 #include "framework/core/registry.hpp"
@@ -157,7 +157,8 @@ void HollowBfs::vertex_distances(const geometry::Mesh& mesh, const Eigen::Vector
       best = std::min(best, (s - 1) * sc + (center + step[n] - p).norm());
     }
     if (!std::isfinite(best)) {
-      throw GeometryError("hollow_dist: vertex " + std::to_string(v) + " has no previous cell on its path to " + bone_name);
+      throw GeometryError("hollow_dist: vertex " + std::to_string(v) +
+                          " has no previous cell on its path to " + bone_name);
     }
     out[v] = best;
   }
@@ -172,7 +173,8 @@ std::size_t HollowBfs::bytes() const {
 std::string describe_bone(const geometry::Skeleton& skeleton, int bone) {
   const auto bones = skeleton.bones();
   const geometry::Bone& b = bones.at(bone);
-  if (b.helper) return "helper bone " + std::to_string(bone) + " (at '" + skeleton.names[b.start] + "')";
+  if (b.helper)
+    return "helper bone " + std::to_string(bone) + " (at '" + skeleton.names[b.start] + "')";
   return "bone " + std::to_string(bone) + " ('" + skeleton.names[b.start] + "' -> '" +
          skeleton.names[b.end] + "')";
 }

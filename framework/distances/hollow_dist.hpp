@@ -26,6 +26,12 @@
 ///   Eq. 1 will read (mesh cells, and their neighbours one step closer) is then final, because
 ///   a BFS level is complete before the next begins. Hollow cells beyond get no distance, which
 ///   the output of Algorithm 1 ("distance between each bone and mesh cells") does not include.
+///   Read literally, lines 20–24 also run once more after the queue empties with every mesh
+///   cell reached (the test is on line 10, after the restart); that only labels hollow cells of
+///   a new phase, which Eq. 1 never reads (see below), so we skip it. The reference in the tests
+///   runs the literal version and agrees.
+/// - Line 13, "untraversed": a cell whose distance is still ∞; bone cells are traversed from
+///   the start, and a cell is labelled when pushed, so it is pushed at most once.
 /// - Line 20, "the nearest mesh cell c_i neighboring to any untraversed hollow cell": "nearest"
 ///   is the smallest distance d_{c_i} (to the bone), among traversed mesh cells (untraversed
 ///   ones have d = ∞); ties go to the smallest (z, y, x) cell coordinates, so results do not

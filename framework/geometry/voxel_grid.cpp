@@ -60,7 +60,8 @@ VoxelGrid VoxelGrid::fit(const Mesh& mesh, const Skeleton& skeleton, int resolut
   }
   const Eigen::Vector3d extent = hi - lo;
   if (!(extent.maxCoeff() > 0) || !extent.allFinite()) {
-    throw GeometryError("voxel grid: the mesh and skeleton have an empty or non-finite bounding box");
+    throw GeometryError(
+        "voxel grid: the mesh and skeleton have an empty or non-finite bounding box");
   }
   VoxelGrid g;
   g.resolution_ = resolution;
@@ -153,7 +154,8 @@ SurfaceVoxels SurfaceVoxels::voxelize(const Mesh& mesh, VoxelGrid grid) {
     s.vertex_cells_[v] = s.grid_.cell_of(mesh.V.row(v));
     mark(s.vertex_cells_[v]);
   }
-  for (std::uint64_t word : s.bits_) s.num_mesh_cells_ += static_cast<int>(std::bitset<64>(word).count());
+  for (std::uint64_t word : s.bits_)
+    s.num_mesh_cells_ += static_cast<int>(std::bitset<64>(word).count());
   return s;
 }
 

@@ -36,9 +36,9 @@ namespace skinlab::geometry {
 /// the 13 axes of Akenine-Möller, "Fast 3D triangle-box overlap testing", JGT 2001): box
 /// normals, triangle normal, and the 9 cross products of triangle edges with box axes. Touching
 /// counts as overlap; the box is grown by 1e-9 of its size so that rounding cannot push a point
-/// lying on a face shared by two cells out of both. Degenerate triangles are handled exactly: a zero axis never separates,
-/// and the axes that remain are those of the segment (or point) the triangle collapses to, so
-/// (a, b, b) is the segment–box test and (a, a, a) the point–box test.
+/// lying on a face shared by two cells out of both. Degenerate triangles are handled exactly: a
+/// zero axis never separates, and the axes that remain are those of the segment (or point) the
+/// triangle collapses to, so (a, b, b) is the segment–box test and (a, a, a) the point–box test.
 bool triangle_box_overlap(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                           const Eigen::Vector3d& c, const Eigen::Vector3d& box_center,
                           const Eigen::Vector3d& box_half_size);
@@ -66,7 +66,9 @@ class VoxelGrid {
   /// Number of padded cells, (nx + 2)(ny + 2)(nz + 2): the length of every per-cell array.
   int num_padded() const { return static_cast<int>(stride_[2]) * (dims_[2] + 2); }
   /// Padded linear index of stored cell (i, j, k), 0 ≤ i < nx etc.
-  int index(int i, int j, int k) const { return (i + 1) + stride_[1] * (j + 1) + stride_[2] * (k + 1); }
+  int index(int i, int j, int k) const {
+    return (i + 1) + stride_[1] * (j + 1) + stride_[2] * (k + 1);
+  }
   /// Stored cell coordinates of a padded index (−1 or n along an axis for padding).
   std::array<int, 3> coords(int index) const;
   /// True for stored cells, false for the padding layer.

@@ -20,10 +20,10 @@ std::shared_ptr<Distance> make(const std::string& yaml) {
 
 TEST(EuclideanDistance, PointSegmentByHand) {
   const Eigen::Vector3d a(0, 0, 0), b(2, 0, 0);
-  EXPECT_DOUBLE_EQ(point_segment_distance({1, 1, 0}, a, b), 1.0);           // above the middle
-  EXPECT_DOUBLE_EQ(point_segment_distance({-1, 0, 0}, a, b), 1.0);          // before the start
+  EXPECT_DOUBLE_EQ(point_segment_distance({1, 1, 0}, a, b), 1.0);              // above the middle
+  EXPECT_DOUBLE_EQ(point_segment_distance({-1, 0, 0}, a, b), 1.0);             // before the start
   EXPECT_DOUBLE_EQ(point_segment_distance({3, 4, 0}, a, b), std::sqrt(17.0));  // past the end
-  EXPECT_DOUBLE_EQ(point_segment_distance({0.5, 0, 0}, a, b), 0.0);         // on the bone
+  EXPECT_DOUBLE_EQ(point_segment_distance({0.5, 0, 0}, a, b), 0.0);            // on the bone
   EXPECT_DOUBLE_EQ(point_segment_distance({1, 2, 2}, a, b), std::sqrt(8.0));
   // A zero-length (helper) bone is a point.
   EXPECT_DOUBLE_EQ(point_segment_distance({1, 2, 2}, b, b), 3.0);
@@ -64,9 +64,9 @@ TEST(EuclideanDistance, OneJointSkeletonIsOneHelperBone) {
 }
 
 TEST(EuclideanDistance, UnknownOptionIsAnError) {
-  expect_error<ConfigError>([] { make("{type: euclidean, resolution: 88}"); },
-                            {"test.yaml:1", "resolution", "unknown field of distance 'euclidean'",
-                             "known fields: type"});
+  expect_error<ConfigError>(
+      [] { make("{type: euclidean, resolution: 88}"); },
+      {"test.yaml:1", "resolution", "unknown field of distance 'euclidean'", "known fields: type"});
 }
 
 TEST(EuclideanDistance, InvalidMeshIsAGeometryError) {

@@ -129,8 +129,9 @@ Reference reference(const Mesh& mesh, const Skeleton& skeleton, int R, int margi
     Reference::Bone bone;
     std::queue<Key> Q;
     for (const Key& k : ref.all_cells()) {  // lines 5–9
-      const bool hit = a == e ? CGAL::do_intersect(point(a), ref.box(k))
-                              : CGAL::do_intersect(Kernel::Segment_3(point(a), point(e)), ref.box(k));
+      const bool hit = a == e
+                           ? CGAL::do_intersect(point(a), ref.box(k))
+                           : CGAL::do_intersect(Kernel::Segment_3(point(a), point(e)), ref.box(k));
       if (hit) {
         bone.steps[k] = 0;
         bone.phase[k] = 0;
@@ -223,7 +224,8 @@ void expect_matches_reference(const Mesh& mesh, const Skeleton& skeleton, int R,
   int fast_mesh = 0;
   for (const Key& k : ref.mesh) {
     ASSERT_TRUE(grid.stored(fast_index(k))) << "mesh cell outside the slab";
-    EXPECT_TRUE(voxels.is_mesh(fast_index(k))) << "cell z=" << k[0] << " y=" << k[1] << " x=" << k[2];
+    EXPECT_TRUE(voxels.is_mesh(fast_index(k)))
+        << "cell z=" << k[0] << " y=" << k[1] << " x=" << k[2];
   }
   for (int i = 0; i < grid.num_padded(); ++i) fast_mesh += voxels.is_mesh(i);
   EXPECT_EQ(fast_mesh, static_cast<int>(ref.mesh.size()));
@@ -294,8 +296,8 @@ TEST(HollowDist, MatchesNaiveReferenceTightMarginAndBoxes) {
 constexpr double kW = 0.25, kL = 1.0;
 
 Mesh u_tube() {
-  const std::vector<Eigen::Vector2d> outline = {{0, 0},      {3 * kW, 0}, {3 * kW, kL}, {2 * kW, kL},
-                                                {2 * kW, kW}, {kW, kW},    {kW, kL},     {0, kL}};
+  const std::vector<Eigen::Vector2d> outline = {
+      {0, 0}, {3 * kW, 0}, {3 * kW, kL}, {2 * kW, kL}, {2 * kW, kW}, {kW, kW}, {kW, kL}, {0, kL}};
   const std::vector<Eigen::Vector4d> caps = {
       {0, 0, kW, kL}, {kW, 0, 2 * kW, kW}, {2 * kW, 0, 3 * kW, kL}};
   return testing::MeshBuilder().prism(outline, caps, kW, 0.05).build();
@@ -319,8 +321,8 @@ TEST(HollowDist, UTubeFollowsTheTubeEuclideanDoesNot) {
   ASSERT_LT((mesh.V.row(v).transpose() - far).norm(), 1e-12);
   // Shortest path inside the U (a lower bound for any path that does not cross the surface):
   // from the bone's lower end around the inner corners (w, w) and (2w, w), then up the arm.
-  const double inside = (Eigen::Vector2d(kW / 2, 0.6) - Eigen::Vector2d(kW, kW)).norm() + kW +
-                        (kL - kW);
+  const double inside =
+      (Eigen::Vector2d(kW / 2, 0.6) - Eigen::Vector2d(kW, kW)).norm() + kW + (kL - kW);
   // The 6-connected search measures that path in the L1 metric: down, across, up.
   const double manhattan = (0.6 - kW) + (2 * kW - kW / 2) + (kL - kW);
   EXPECT_GE(H(v, 0), inside - tolerance);
@@ -417,9 +419,9 @@ TEST(HollowDist, VertexInBoneCellUsesEuclideanDistance) {
   for (int v = 0; v < mesh.num_vertices(); ++v) {
     if (bfs.steps(voxels.vertex_cells()[v]) != 0) continue;
     ++in_bone_cells;
-    EXPECT_DOUBLE_EQ(H(v, 0), point_segment_distance(mesh.V.row(v).transpose(),
-                                                     joints.row(0).transpose(),
-                                                     joints.row(1).transpose()));
+    EXPECT_DOUBLE_EQ(H(v, 0),
+                     point_segment_distance(mesh.V.row(v).transpose(), joints.row(0).transpose(),
+                                            joints.row(1).transpose()));
   }
   EXPECT_GT(in_bone_cells, 0);  // the end-face centres
 }
@@ -428,8 +430,8 @@ TEST(HollowDist, UnreachedVertexIsAGeometryErrorNamingVertexAndBone) {
   const Mesh mesh = testing::MeshBuilder().box({0, 0, 0}, {1, 1, 1}, 1).build();
   Eigen::MatrixXd joints(2, 3);
   joints << 0.5, 0.5, 0.2, 0.5, 0.5, 0.8;
-  const Skeleton skeleton = Skeleton::from_parent_names({"hips", "spine"}, joints, {"", "hips"},
-                                                        "test");
+  const Skeleton skeleton =
+      Skeleton::from_parent_names({"hips", "spine"}, joints, {"", "hips"}, "test");
   const auto voxels = HollowDist(HollowDist::Options{}).voxelize(mesh, skeleton);
   HollowBfs bfs(voxels);  // no run: nothing is reached
   Eigen::VectorXd out(mesh.num_vertices());
@@ -538,8 +540,8 @@ TEST(HollowDistGrid, ThinSheetIsNotMissed) {
   mesh.F << 0, 1, 2;
   Eigen::MatrixXd joint(1, 3);
   joint << 0.5, 0.5, 0.0;
-  const auto voxels =
-      geometry::SurfaceVoxels::voxelize(mesh, geometry::VoxelGrid::fit(mesh, testing::chain(joint), 16, 2));
+  const auto voxels = geometry::SurfaceVoxels::voxelize(
+      mesh, geometry::VoxelGrid::fit(mesh, testing::chain(joint), 16, 2));
   // The sheet passes ~0.04 (half a cell) from every cell centre, so sampling cell centres would
   // miss it entirely; the overlap test marks every cell it passes through (about 11×11 / 2).
   EXPECT_GE(voxels.num_mesh_cells(), 60);
@@ -564,10 +566,10 @@ TEST(HollowDistOptions, DefaultsFollowThePaper) {
 }
 
 TEST(HollowDistOptions, ErrorsNameTheField) {
-  expect_error<ConfigError>([] { make("{type: hollow_dist, resolutoin: 64}"); },
-                            {"test.yaml:1", "resolutoin", "unknown field of distance 'hollow_dist'",
-                             "did you mean 'resolution'?",
-                             "known fields: margin_cells, resolution, type"});
+  expect_error<ConfigError>(
+      [] { make("{type: hollow_dist, resolutoin: 64}"); },
+      {"test.yaml:1", "resolutoin", "unknown field of distance 'hollow_dist'",
+       "did you mean 'resolution'?", "known fields: margin_cells, resolution, type"});
   expect_error<ConfigError>([] { make("{type: hollow_dist, resolution: 7}"); },
                             {"test.yaml:1", "resolution", "must be at least 8"});
   expect_error<ConfigError>([] { make("{type: hollow_dist, resolution: 2000}"); },
