@@ -102,7 +102,7 @@ TEST(Registry, ExactKeysOfEveryCategory) {
   std::map<std::string, std::vector<std::string>> actual;
   for (const auto* registry : all_registries()) actual[registry->name()] = registry->keys();
   const std::map<std::string, std::vector<std::string>> expected = {
-      {"distance", {"volumetric_geodesic"}},
+      {"distance", {"euclidean", "hollow_dist", "volumetric_geodesic"}},
       {"graph_op", {}},
       {"model", {}},
       {"loss", {"kl", "laplacian_smoothing", "mse", "soft_cross_entropy"}},

@@ -1,0 +1,33 @@
+#pragma once
+/// \file
+/// `euclidean`: the straight-line vertex–bone distance that NeuroSkinning (Liu et al. 2019) uses
+/// to pick candidate bones, and the baseline HollowDist is compared with (HeterSkinNet Sec. 3.1,
+/// Table 3 "Euclidean"). It ignores the mesh, so its paths may cross the surface.
+
+#include <Eigen/Core>
+
+#include "framework/core/config.hpp"
+#include "framework/distances/distance.hpp"
+
+namespace skinlab::distances {
+
+/// Distance from point `p` to the closed segment [a, b]; the distance to `a` when a == b (a
+/// helper bone). Units of the inputs.
+double point_segment_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                              const Eigen::Vector3d& b);
+
+class Euclidean final : public Distance {
+ public:
+  /// No options; an unknown field is an error.
+  struct Options {
+    static Options from(const config::Node& node);
+  };
+  explicit Euclidean(Options /*options*/ = {}) {}
+
+  /// #V×#B: D(v, b) = distance from vertex v to the segment of bone b (`Skeleton::bones()`
+  /// order; a point for helper bones), in mesh units. Validates mesh and skeleton first.
+  Eigen::MatrixXd compute(const geometry::Mesh& mesh,
+                          const geometry::Skeleton& skeleton) const override;
+};
+
+}  // namespace skinlab::distances
