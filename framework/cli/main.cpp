@@ -15,11 +15,12 @@
 #include "framework/core/error.hpp"
 #include "framework/core/logging.hpp"
 #include "framework/core/registry.hpp"
+#include "framework/cli/commands.hpp"
 #include "framework/train/run_options.hpp"
 
-namespace {
+namespace skinlab::cli {
 
-using namespace skinlab;
+namespace {
 
 int run_info(bool as_json) {
   nlohmann::json registries = nlohmann::json::object();
@@ -53,14 +54,31 @@ int run_info(bool as_json) {
   return 0;
 }
 
-int run_config(const std::string& file, const std::vector<std::string>& overrides) {
-  const config::Config config = config::Config::load(file, overrides);
-  train::RunOptions::from(config);  // validates every section before printing
-  std::cout << config.to_yaml();
-  return 0;
+}  // namespace
+
+Command add_info(CLI::App& app) {
+  auto* cmd = app.add_subcommand("info", "versions, threads and every registry with its keys");
+  auto as_json = std::make_shared<bool>(false);
+  cmd->add_flag("--json", *as_json, "print as JSON");
+  return {cmd, [as_json] { return run_info(*as_json); }};
 }
 
-}  // namespace
+Command add_config(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "config", "print the fully resolved config (bases merged, overrides applied, validated)");
+  auto file = std::make_shared<std::string>();
+  auto overrides = std::make_shared<std::vector<std::string>>();
+  cmd->add_option("file", *file, "experiment config (YAML)")->required();
+  cmd->add_option("overrides", *overrides, "key.sub=value assignments, applied in order");
+  return {cmd, [file, overrides] {
+            const config::Config config = config::Config::load(*file, *overrides);
+            train::RunOptions::from(config);  // validates every section before printing
+            std::cout << config.to_yaml();
+            return 0;
+          }};
+}
+
+}  // namespace skinlab::cli
 
 int main(int argc, char** argv) {
   CLI::App app{"skinlab: learned character skinning (HeterSkinNet and baselines)"};
@@ -72,16 +90,9 @@ int main(int argc, char** argv) {
   app.add_option("--threads", threads, "libtorch threads; 0 = every hardware thread")
       ->capture_default_str();
 
-  auto* info = app.add_subcommand("info", "versions, threads and every registry with its keys");
-  bool info_json = false;
-  info->add_flag("--json", info_json, "print as JSON");
-
-  auto* config_cmd = app.add_subcommand(
-      "config", "print the fully resolved config (bases merged, overrides applied, validated)");
-  std::string config_file;
-  std::vector<std::string> overrides;
-  config_cmd->add_option("file", config_file, "experiment config (YAML)")->required();
-  config_cmd->add_option("overrides", overrides, "key.sub=value assignments, applied in order");
+  const std::vector<skinlab::cli::Command> commands = {
+      skinlab::cli::add_info(app), skinlab::cli::add_config(app),
+      skinlab::cli::add_distance(app)};
 
   try {
     app.parse(argc, argv);
@@ -90,11 +101,12 @@ int main(int argc, char** argv) {
   }
 
   try {
-    logging::init(log_level);
-    verify_registries();
-    set_torch_threads(threads);
-    if (*info) return run_info(info_json);
-    if (*config_cmd) return run_config(config_file, overrides);
+    skinlab::logging::init(log_level);
+    skinlab::verify_registries();
+    skinlab::set_torch_threads(threads);
+    for (const auto& command : commands) {
+      if (command.app->parsed()) return command.run();
+    }
   } catch (const std::exception& e) {
     std::fflush(stdout);
     std::cerr << "skinlab: error: " << e.what() << "\n";

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <nlohmann/json.hpp>
@@ -97,6 +98,30 @@ TEST(Cli, WrongTypeMissingFileAndBadUsage) {
   const Result l = run("--log-level loud info");
   EXPECT_EQ(l.status, 1);
   EXPECT_NE(l.err.find("unknown log level 'loud'"), std::string::npos) << l.err;
+}
+
+TEST(Cli, DistanceOfARealCharacterToHdf5AndCsv) {
+  TempDir dir;
+  const std::string player =
+      "/usr/share/games/minetest/games/minetest_game/mods/player_api/models/character.b3d";
+  const Result r = run("distance " + player + " --type hollow_dist --option resolution=32 --out " +
+                       (dir / "D.h5").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("character: 168 vertices, 6 joints, 10 bones"), std::string::npos) << r.out;
+  EXPECT_TRUE(std::filesystem::exists(dir / "D.h5"));
+  const Result c = run("distance " + player + " --type euclidean --out " + (dir / "D.csv").string());
+  ASSERT_EQ(c.status, 0) << c.err;
+  const std::string csv = read_file(dir / "D.csv");
+  EXPECT_EQ(csv.rfind("vertex,Body->Head,", 0), 0u) << csv.substr(0, 200);
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 169);  // header + one line per vertex
+
+  const Result bad = run("distance " + player + " --type hollow_dist --option resolution=4");
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_NE(bad.err.find("resolution: must be at least 8"), std::string::npos) << bad.err;
+  const Result ext = run("distance " + player + " --type euclidean --out " + (dir / "D.txt").string());
+  EXPECT_EQ(ext.status, 1);
+  EXPECT_NE(ext.err.find("unknown output type '.txt'"), std::string::npos) << ext.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "D.txt"));
 }
 
 }  // namespace

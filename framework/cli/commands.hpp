@@ -1,0 +1,22 @@
+#pragma once
+/// \file
+/// Subcommands of `skinlab`. Each `add_*` declares its options on `app` and returns the
+/// subcommand; `main` runs the one the user chose. Each `run` may throw; `main` reports.
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+
+namespace skinlab::cli {
+
+/// A parsed subcommand and what running it does.
+struct Command {
+  CLI::App* app;
+  std::function<int()> run;
+};
+
+Command add_info(CLI::App& app);
+Command add_config(CLI::App& app);
+Command add_distance(CLI::App& app);
+
+}  // namespace skinlab::cli
