@@ -11,11 +11,6 @@
 
 namespace skinlab::distances {
 
-/// Distance from point `p` to the closed segment [a, b]; the distance to `a` when a == b (a
-/// helper bone). Units of the inputs.
-double point_segment_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
-                              const Eigen::Vector3d& b);
-
 class Euclidean final : public Distance {
  public:
   /// No options; an unknown field is an error.

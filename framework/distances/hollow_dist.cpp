@@ -10,7 +10,7 @@
 #include <limits>
 
 #include "framework/core/registry.hpp"
-#include "framework/distances/euclidean.hpp"
+#include "framework/geometry/closest_point_on_segment.hpp"
 
 namespace skinlab::distances {
 
@@ -146,7 +146,7 @@ void HollowBfs::vertex_distances(const geometry::Mesh& mesh, const Eigen::Vector
                           " (its cell was never reached by the search)");
     }
     if (s == 0) {  // bone cell: no previous cell on the path
-      out[v] = point_segment_distance(p, a, b);
+      out[v] = geometry::point_segment_distance(p, a, b);
       continue;
     }
     const Eigen::Vector3d center = grid.center(c);

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "framework/core/registry.hpp"
+#include "framework/geometry/closest_point_on_segment.hpp"
 
 namespace skinlab::distances {
 
@@ -94,14 +95,10 @@ SurfaceGraph build_graph(const geometry::Mesh& mesh) {
   return g;
 }
 
-/// Closest point of segment [a, b] to p; a zero-length bone (RigNet: |b−a|² < 1e-8) is its joint.
+/// Closest point of bone [a, b] to p; a bone with |b−a|² < 1e-8 is its joint (RigNet's rule).
 Eigen::Vector3d project_on_bone(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
                                 const Eigen::Vector3d& b) {
-  const Eigen::Vector3d ab = b - a;
-  const double l2 = ab.squaredNorm();
-  if (l2 < 1e-8) return a;
-  const double t = std::clamp((p - a).dot(ab) / l2, 0.0, 1.0);
-  return a + t * ab;
+  return geometry::closest_point_on_segment(p, a, b, 1e-8);
 }
 
 /// numpy.percentile's default (linear interpolation between order statistics); sorts `x`.

@@ -6,6 +6,7 @@
 
 #include "framework/core/registry.hpp"
 #include "framework/distances/euclidean.hpp"
+#include "framework/geometry/closest_point_on_segment.hpp"
 #include "tests/distances/shapes.hpp"
 #include "tests/test_util.hpp"
 
@@ -13,6 +14,7 @@ namespace skinlab::distances {
 namespace {
 
 using skinlab::testing::expect_error;
+using geometry::point_segment_distance;
 
 std::shared_ptr<Distance> make(const std::string& yaml) {
   return distance_registry().create(config::Config::parse(yaml, "test.yaml").root());

@@ -18,6 +18,7 @@
 
 #include "framework/core/registry.hpp"
 #include "framework/distances/euclidean.hpp"
+#include "framework/geometry/closest_point_on_segment.hpp"
 #include "framework/distances/hollow_dist.hpp"
 #include "framework/geometry/voxel_grid.hpp"
 #include "tests/distances/shapes.hpp"
@@ -27,6 +28,7 @@ namespace skinlab::distances {
 namespace {
 
 using geometry::Mesh;
+using geometry::point_segment_distance;
 using geometry::Skeleton;
 using skinlab::testing::expect_error;
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
