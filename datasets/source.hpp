@@ -1,0 +1,56 @@
+#pragma once
+/// \file
+/// Interface of the `dataset` registry: a builder reads one raw source (a game data package, a
+/// folder of rigged files) into characters with their provenance. Cleaning, preprocessing
+/// (HeterSkinNet Sec. 4.1), splitting and the HDF5 file are shared code in framework/data; a
+/// builder only reads.
+
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+#include "framework/geometry/skin_weights.hpp"
+
+namespace skinlab::datasets {
+
+/// A clip of real poses of one character's skeleton.
+struct Animation {
+  std::string name;  ///< e.g. "biped/walk" (source-specific)
+  double fps = 0;    ///< frames per second, 0 when unknown
+  /// frames[f][j]: joint j's global transform at frame f, in the character's frame and units
+  /// (the frame of Character::skeleton in the bind pose). LBS moves a vertex by
+  /// frames[f][j] · bind(j)⁻¹, where bind(j) is the joint's bind-pose global transform.
+  std::vector<std::vector<Eigen::Isometry3d>> frames;
+  /// bind[j]: joint j's bind-pose global transform (same frame), so that the above is defined
+  /// even where bind-pose joint orientations are not the identity.
+  std::vector<Eigen::Isometry3d> bind;
+};
+
+/// One character as its source provides it, before cleaning and preprocessing.
+struct SourceCharacter {
+  geometry::Character character;  ///< bind pose, file frame and units; name unique in the source
+  std::string source;             ///< registry key of the builder, e.g. "zeroad"
+  std::string path;               ///< where it came from inside the source
+  std::string licence;            ///< SPDX-style, e.g. "CC-BY-SA-3.0"
+  std::string attribution;        ///< who made it, for the dataset card
+  std::string skeleton;           ///< skeleton family (e.g. "biped", "horse"): grouping, splits
+  std::vector<Animation> animations;
+};
+
+/// A character a builder could not use, with the reason (reported in the dataset card).
+struct Excluded {
+  std::string source;
+  std::string path;
+  std::string reason;
+};
+
+class DatasetBuilder {
+ public:
+  virtual ~DatasetBuilder() = default;
+  /// Reads every character of the source. A character that cannot be read or fails validation
+  /// goes to `excluded` with its reason; only a source that cannot be read at all (missing
+  /// directory, unreadable archive) throws.
+  virtual std::vector<SourceCharacter> read(std::vector<Excluded>& excluded) const = 0;
+};
+
+}  // namespace skinlab::datasets
