@@ -52,11 +52,22 @@ SourceRig to_source_rig(const RiggedModel& model) {
   // Keep a joint unless its root's subtree carries no weight.
   std::vector<int> root_of(n);
   for (int j = 0; j < n; ++j) root_of[j] = model.parents[j] < 0 ? j : root_of[model.parents[j]];
+  // Joints under an unusable joint go too; they must not skin anything.
+  std::vector<bool> dropped(n, false);
+  for (int j = 0; j < n; ++j) {
+    const bool unusable = !model.unusable.empty() && model.unusable[j];
+    dropped[j] = unusable || (model.parents[j] >= 0 && dropped[model.parents[j]]);
+    if (unusable && subtree[j] > 0) {
+      throw GeometryError(model.name + ": joint " + std::to_string(j) + " '" +
+                          model.joint_names[j] +
+                          "' has a degenerate transform but its subtree carries weights");
+    }
+  }
   std::vector<int> kept, new_index(n, -1);
   std::string weighted_roots;
   int num_roots = 0;
   for (int j = 0; j < n; ++j) {
-    if (subtree[root_of[j]] <= 0) continue;
+    if (subtree[root_of[j]] <= 0 || dropped[j]) continue;
     new_index[j] = static_cast<int>(kept.size());
     kept.push_back(j);
     if (model.parents[j] < 0) {

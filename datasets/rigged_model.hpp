@@ -30,6 +30,10 @@ struct RiggedModel {
   Eigen::MatrixXd V;                     ///< #V×3 bind-pose positions (file frame, units)
   Eigen::MatrixXi F;                     ///< #F×3 triangles
   geometry::SparseWeights W;             ///< #V×#J weights, rows sum to 1
+  /// #J flags (or empty): joints whose transforms are degenerate in some pose (e.g. all-zero
+  /// matrices of unused helper bones); they are pruned with their subtrees, which must carry
+  /// no weight.
+  std::vector<bool> unusable;
 };
 
 /// A character with the map back to the file's joints, for converting animations.
@@ -45,8 +49,9 @@ struct SourceRig {
 Transforms compose_global(const Transforms& local, const std::vector<int>& parents,
                           const std::vector<std::string>& names, const std::string& source);
 
-/// Prunes unweighted root subtrees (see the file comment), builds and validates the Character.
-/// Throws GeometryError naming the model for several weighted roots or any validation error.
+/// Prunes unweighted root subtrees (see the file comment) and the subtrees of `unusable` joints,
+/// builds and validates the Character. Throws GeometryError naming the model for several weighted
+/// roots, a weighted unusable subtree, or any validation error.
 SourceRig to_source_rig(const RiggedModel& model);
 
 /// An Animation of `rig` from per-frame global transforms of all file joints

@@ -111,15 +111,15 @@ ZymFile read_zym(std::string_view bytes, const std::string& source) {
                                 r.f32(o + 12, idx("vertex", v)));
     if (!origin[v].allFinite()) r.fail(o, idx("vertex", v), "non-finite origin");
   }
-  // Bones in a tree that skins something must have proper transforms. Other trees (exporter
-  // helpers such as "smdimport" or a camera target, often with all-zero matrices) are pruned by
-  // to_source_rig; their transforms are kept only where they are valid.
-  std::vector<int> root_of(nb);
-  std::vector<bool> skinning_root(nb, false), checked(nb);
-  for (std::size_t b = 0; b < nb; ++b)
-    root_of[b] = m.parents[b] < 0 ? int(b) : root_of[m.parents[b]];
-  for (int bone : vertex_bone) skinning_root[root_of[bone]] = true;
-  for (std::size_t b = 0; b < nb; ++b) checked[b] = skinning_root[root_of[b]];
+  // Only the bones that skin vertices and their ancestors must have proper transforms. Helper
+  // bones outside that set (exporter roots like "smdimport", camera targets, weapon attachment
+  // points like "shotgun") often have all-zero matrices: they are marked `unusable` and
+  // to_source_rig prunes them with their (unweighted) subtrees.
+  std::vector<bool> checked(nb, false);
+  for (int bone : vertex_bone) {
+    for (int j = bone; j >= 0 && !checked[j]; j = m.parents[j]) checked[j] = true;
+  }
+  m.unusable.assign(nb, false);
 
   // Poses: parent-relative 3×4 matrices, composed to global transforms. The exporter scales
   // the model (`modelscale`) through the root bones' matrices, so global linear parts are
@@ -151,8 +151,14 @@ ZymFile read_zym(std::string_view bytes, const std::string& source) {
       const double s = std::cbrt(det);
       if (!checked[b]) {
         rigid[b] = Eigen::Isometry3d::Identity();
-        if (s > 0) rigid[b].linear() = global[b].linear() / s;
         rigid[b].translation() = global[b].translation();
+        const Eigen::Matrix3d R = global[b].linear() / s;
+        if (s > 0 && (scale == 0 || std::abs(s - scale) <= 1e-3 * scale) &&
+            (R.transpose() * R - Eigen::Matrix3d::Identity()).norm() <= 1e-3 && R.allFinite()) {
+          rigid[b].linear() = R;
+        } else {
+          m.unusable[b] = true;
+        }
         continue;
       }
       if (scale == 0) scale = s;

@@ -21,6 +21,8 @@
 /// per influence; so does this reader. The exporter bakes the model scale into the root bones'
 /// matrices (Nexuiz players: 0.7); vertices are placed with the scaled matrices, and the stored
 /// transforms are their rigid parts (the uniform scale cancels in every skinning transform).
+/// Helper bones that neither skin a vertex nor are an ancestor of one (weapon attachment points,
+/// exporter roots) may have all-zero matrices; they are flagged `RiggedModel::unusable`.
 /// Triangles are stored clockwise (Quake); like DarkPlaces we reverse them to counter-clockwise.
 /// Frame and units as in the file (Quake units, Z up).
 

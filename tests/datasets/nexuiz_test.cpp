@@ -221,6 +221,28 @@ TEST(Pk3, TruncatedOrCorruptArchivesAreErrors) {
                                  {"foreign.pk3", "not a zip"});
 }
 
+TEST(RiggedModel, PrunesUnusableHelperSubtreesButNotWeightedOnes) {
+  // Root, hand (skins the triangle) and a weapon tag under the hand with a degenerate matrix.
+  RiggedModel m;
+  m.name = "toy";
+  m.joint_names = {"root", "hand", "tag", "tag_child"};
+  m.parents = {-1, 0, 1, 2};
+  m.bind.assign(4, Eigen::Isometry3d::Identity());
+  m.V = Eigen::MatrixXd::Identity(3, 3);
+  m.F = Eigen::MatrixXi(1, 3);
+  m.F << 0, 1, 2;
+  m.W.resize(3, 4);
+  for (int v = 0; v < 3; ++v) m.W.insert(v, 1) = 1.0;
+  m.unusable = {false, false, true, false};
+  const SourceRig rig = to_source_rig(m);
+  EXPECT_EQ(rig.character.skeleton.names, (std::vector<std::string>{"root", "hand"}));
+  EXPECT_EQ(rig.kept, (std::vector<int>{0, 1}));
+  m.W.coeffRef(2, 1) = 0.5;
+  m.W.insert(2, 3) = 0.5;  // now the unusable tag's subtree skins vertex 2
+  testing::expect_error<geometry::GeometryError>([&] { to_source_rig(m); },
+                                                 {"toy", "joint 2 'tag'", "degenerate"});
+}
+
 TEST(Nexuiz, RegisteredWithOptions) {
   const auto config =
       config::Config::parse("{type: nexuiz, path: /nonexistent/data.pk3, lods: true}", "d.yaml");
