@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <iostream>
 
 #include "framework/cli/commands.hpp"
@@ -12,6 +13,11 @@
 namespace skinlab::cli {
 
 namespace {
+
+/// Vertices after merging: the vertex map's image is 0..n−1 (subdivision appends after them).
+int merged(const data::PreparedCharacter& c) {
+  return c.vertex_map.empty() ? 0 : *std::max_element(c.vertex_map.begin(), c.vertex_map.end()) + 1;
+}
 
 int run_dataset_info(const std::string& file) {
   const data::Dataset d = data::read_dataset(file);
@@ -25,9 +31,10 @@ int run_dataset_info(const std::string& file) {
           (distances.empty() ? "" : ", ") + type + fmt::format(" (K={})", dd.topk_index.cols());
     }
     std::cout << fmt::format(
-        "  {}: {} vertices ({} original, {} subdivision levels), {} faces, {} joints, {} bones, "
+        "  {}: {} vertices ({} original, {} merged, {} subdivision levels), {} faces, {} joints, "
+        "{} bones, "
         "{} animations; distances: {}; source {} ({}), skeleton {}, licence {}\n",
-        c.name, c.num_vertices(), c.vertex_map.size(), c.subdivision_levels, c.F.rows(),
+        c.name, c.num_vertices(), c.vertex_map.size(), merged(c), c.subdivision_levels, c.F.rows(),
         c.num_joints(), c.num_bones(), c.animations.size(), distances.empty() ? "none" : distances,
         c.source, c.path, c.skeleton, c.licence.empty() ? "unknown" : c.licence);
   }

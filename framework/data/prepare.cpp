@@ -46,6 +46,19 @@ std::vector<NamedDistance> make_distances(const std::vector<config::Node>& nodes
   return out;
 }
 
+/// `text` with every line indented by two spaces and ending in a newline (a YAML block).
+std::string indent(const std::string& text) {
+  std::string out;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    std::size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    if (end > start) out += "  " + text.substr(start, end - start) + "\n";
+    start = end + 1;
+  }
+  return out;
+}
+
 std::string git_commit() {
   const GitState git = git_state(source_dir());
   return git.commit + (git.dirty ? "-dirty" : "");
@@ -86,8 +99,8 @@ PrepareConfig PrepareConfig::from(const config::Config& config) {
   c.output = output;
   for (const auto& node : c.sources) dataset_registry().create(node);  // validates options
   make_distances(c.distances);
-  c.preparation = "preprocess:\n" + (preprocess.exists() ? preprocess.to_yaml() : "{}") +
-                  "\ndistances:\n" + distances.to_yaml() + "\n";
+  c.preparation = "preprocess:\n" + indent(preprocess.exists() ? preprocess.to_yaml() : "{}") +
+                  "distances:\n" + indent(distances.to_yaml());
   return c;
 }
 

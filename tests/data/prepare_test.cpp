@@ -35,6 +35,9 @@ data::PrepareOptions quiet(bool keep_partial) {
 TEST(Prepare, SecondRunReusesDoneCharacters) {
   TempDir dir;
   const auto config = minetest_config(dir);
+  const auto recorded = config::Config::parse(config.preparation).root();
+  EXPECT_EQ(recorded["distances"][0]["type"].as<std::string>(), "euclidean");
+  EXPECT_EQ(recorded["preprocess"]["top_k"].as<int>(), 3);
   const auto first = data::prepare_dataset(config, quiet(true));
   EXPECT_EQ(first.characters, 1u);
   EXPECT_EQ(first.computed, 1u);
