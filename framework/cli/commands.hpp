@@ -18,5 +18,7 @@ struct Command {
 Command add_info(CLI::App& app);
 Command add_config(CLI::App& app);
 Command add_distance(CLI::App& app);
+Command add_prepare(CLI::App& app);
+Command add_dataset_info(CLI::App& app);
 
 }  // namespace skinlab::cli

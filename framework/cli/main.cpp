@@ -92,7 +92,8 @@ int main(int argc, char** argv) {
 
   const std::vector<skinlab::cli::Command> commands = {
       skinlab::cli::add_info(app), skinlab::cli::add_config(app),
-      skinlab::cli::add_distance(app)};
+      skinlab::cli::add_distance(app), skinlab::cli::add_prepare(app),
+      skinlab::cli::add_dataset_info(app)};
 
   try {
     app.parse(argc, argv);

@@ -2,56 +2,146 @@
 
 #include <H5Cpp.h>
 
+#include <algorithm>
+#include <functional>
+#include <numeric>
+
 #include "framework/core/error.hpp"
 
 namespace skinlab::data {
 
 namespace {
 
-[[noreturn]] void rethrow(const std::filesystem::path& file, const std::string& what,
-                          const H5::Exception& e) {
-  throw IoError(file.string() + ": " + what + ": " + e.getDetailMsg());
+/// The innermost description on HDF5's error stack (e.g. "truncated file: eof = ..."), which
+/// says more than the C++ wrapper's "H5Fopen failed".
+std::string hdf5_cause() {
+  std::string cause;
+  H5Ewalk2(
+      H5E_DEFAULT, H5E_WALK_DOWNWARD,
+      [](unsigned, const H5E_error2_t* e, void* out) -> herr_t {
+        if (e->desc != nullptr && e->desc[0] != '\0') *static_cast<std::string*>(out) = e->desc;
+        return 0;
+      },
+      &cause);
+  return cause;
 }
 
-void ensure_groups(H5::H5File& file, const std::string& name) {
-  for (auto pos = name.find('/', 1); pos != std::string::npos; pos = name.find('/', pos + 1)) {
-    const std::string group = name.substr(0, pos);
-    if (!file.nameExists(group)) file.createGroup(group);
+[[noreturn]] void rethrow(const std::filesystem::path& file, const std::string& what,
+                          const H5::Exception& e) {
+  std::string cause = hdf5_cause();
+  if (cause.empty()) cause = e.getDetailMsg();
+  throw IoError(file.string() + ": " + what + ": " + cause);
+}
+
+void ensure_groups(H5::H5File& file, const std::string& name, bool including_last) {
+  std::size_t pos = name.find('/', 1);
+  for (;; pos = name.find('/', pos + 1)) {
+    const std::string group = pos == std::string::npos ? name : name.substr(0, pos);
+    if (pos == std::string::npos && !including_last) return;
+    if (!group.empty() && group != "/" && !file.nameExists(group)) file.createGroup(group);
+    if (pos == std::string::npos) return;
   }
 }
 
-template <class Matrix>
-void write_matrix(H5::H5File& file, const std::filesystem::path& path, const std::string& name,
-                  const Matrix& m, const H5::PredType& type) {
+std::size_t product(const std::vector<hsize_t>& dims) {
+  return std::accumulate(dims.begin(), dims.end(), std::size_t{1},
+                         [](std::size_t a, hsize_t b) { return a * static_cast<std::size_t>(b); });
+}
+
+/// Chunked + deflate above kChunkThreshold: chunks span whole trailing dimensions and about
+/// 64 Ki elements of the first, so a reader of one row (one vertex) decompresses little.
+H5::DSetCreatPropList creation_properties(const std::vector<hsize_t>& dims) {
+  H5::DSetCreatPropList props;
+  if (dims.empty() || product(dims) < kChunkThreshold) return props;
+  std::vector<hsize_t> chunk = dims;
+  const std::size_t rest = product(dims) / static_cast<std::size_t>(dims[0]);
+  chunk[0] =
+      std::max<hsize_t>(1, std::min<hsize_t>(dims[0], 65536 / std::max<std::size_t>(1, rest)));
+  props.setChunk(static_cast<int>(chunk.size()), chunk.data());
+  props.setDeflate(kDeflateLevel);
+  return props;
+}
+
+template <class T>
+void write_array(H5::H5File& file, const std::filesystem::path& path, const std::string& name,
+                 const std::vector<hsize_t>& dims, const T* data, const H5::PredType& type) {
   try {
-    ensure_groups(file, name);
-    const hsize_t dims[2] = {static_cast<hsize_t>(m.rows()), static_cast<hsize_t>(m.cols())};
-    H5::DataSpace space(2, dims);
-    H5::DataSet set = file.createDataSet(name, type, space);
-    if (m.size() > 0) set.write(m.data(), type);
+    ensure_groups(file, name, false);
+    H5::DataSpace space(static_cast<int>(dims.size()), dims.data());
+    H5::DataSet set = file.createDataSet(name, type, space, creation_properties(dims));
+    if (product(dims) > 0) set.write(data, type);
   } catch (const H5::Exception& e) {
     rethrow(path, "cannot write dataset '" + name + "'", e);
   }
 }
 
 template <class Matrix>
-Matrix read_matrix(H5::H5File& file, const std::filesystem::path& path, const std::string& name,
-                   const H5::PredType& type) {
-  if (!file.nameExists(name)) throw IoError(path.string() + ": no dataset '" + name + "'");
+void write_matrix(H5::H5File& file, const std::filesystem::path& path, const std::string& name,
+                  const Matrix& m, const H5::PredType& type) {
+  write_array(file, path, name, {static_cast<hsize_t>(m.rows()), static_cast<hsize_t>(m.cols())},
+              m.data(), type);
+}
+
+H5::DataSet open_dataset(H5::H5File& file, const std::filesystem::path& path,
+                         const std::string& name, std::vector<hsize_t>& dims) {
+  H5::DataSet set = file.openDataSet(name);
+  H5::DataSpace space = set.getSpace();
+  const int rank = space.getSimpleExtentNdims();
+  dims.assign(static_cast<std::size_t>(std::max(rank, 0)), 0);
+  if (rank > 0) space.getSimpleExtentDims(dims.data());
+  (void)path;
+  return set;
+}
+
+bool link_exists(H5::H5File& file, const std::string& name) {
+  // H5Lexists fails (rather than returning false) when an intermediate group is missing.
+  std::size_t pos = name.find('/', 1);
+  for (;; pos = name.find('/', pos + 1)) {
+    const std::string prefix = pos == std::string::npos ? name : name.substr(0, pos);
+    if (!prefix.empty() && prefix != "/" && !file.nameExists(prefix)) return false;
+    if (pos == std::string::npos) return true;
+  }
+}
+
+template <class T>
+std::vector<T> read_values(H5::H5File& file, const std::filesystem::path& path,
+                           const std::string& name, int rank, const H5::PredType& type,
+                           std::vector<std::size_t>* dims_out = nullptr) {
+  if (!link_exists(file, name)) throw IoError(path.string() + ": no dataset '" + name + "'");
   try {
-    H5::DataSet set = file.openDataSet(name);
-    H5::DataSpace space = set.getSpace();
-    if (space.getSimpleExtentNdims() != 2) {
-      throw IoError(path.string() + ": dataset '" + name + "' is not 2-D");
+    std::vector<hsize_t> dims;
+    H5::DataSet set = open_dataset(file, path, name, dims);
+    if (rank >= 0 && static_cast<int>(dims.size()) != rank) {
+      throw IoError(path.string() + ": dataset '" + name + "' has rank " +
+                    std::to_string(dims.size()) + ", expected " + std::to_string(rank));
     }
-    hsize_t dims[2];
-    space.getSimpleExtentDims(dims);
-    Matrix m(static_cast<Eigen::Index>(dims[0]), static_cast<Eigen::Index>(dims[1]));
-    if (m.size() > 0) set.read(m.data(), type);  // converts from the stored type
-    return m;
+    const H5T_class_t cls = set.getTypeClass();
+    if (cls != H5T_INTEGER && cls != H5T_FLOAT) {
+      throw IoError(path.string() + ": dataset '" + name + "' is not numeric");
+    }
+    std::vector<T> values(product(dims));
+    if (!values.empty()) set.read(values.data(), type);  // converts from the stored type
+    if (dims_out != nullptr) dims_out->assign(dims.begin(), dims.end());
+    return values;
   } catch (const H5::Exception& e) {
     rethrow(path, "cannot read dataset '" + name + "'", e);
   }
+}
+
+template <class Matrix>
+Matrix read_matrix(H5::H5File& file, const std::filesystem::path& path, const std::string& name,
+                   const H5::PredType& type) {
+  std::vector<std::size_t> dims;
+  const auto values = read_values<typename Matrix::Scalar>(file, path, name, 2, type, &dims);
+  Matrix m(static_cast<Eigen::Index>(dims[0]), static_cast<Eigen::Index>(dims[1]));
+  std::copy(values.begin(), values.end(), m.data());
+  return m;
+}
+
+H5::Group open_or_create_group(H5::H5File& file, const std::string& object) {
+  if (object.empty() || object == "/") return file.openGroup("/");
+  ensure_groups(file, object, true);
+  return file.openGroup(object);
 }
 
 }  // namespace
@@ -76,15 +166,82 @@ void H5Writer::write(const std::string& name, const RowMatrixXf& m) {
 void H5Writer::write(const std::string& name, const RowMatrixXi& m) {
   write_matrix(*file_, out_.target(), name, m, H5::PredType::NATIVE_INT);
 }
+void H5Writer::write(const std::string& name, const std::vector<int>& v) {
+  write_array(*file_, out_.target(), name, {v.size()}, v.data(), H5::PredType::NATIVE_INT);
+}
+void H5Writer::write(const std::string& name, const std::vector<float>& v) {
+  write_array(*file_, out_.target(), name, {v.size()}, v.data(), H5::PredType::NATIVE_FLOAT);
+}
+void H5Writer::write(const std::string& name, const std::vector<double>& v) {
+  write_array(*file_, out_.target(), name, {v.size()}, v.data(), H5::PredType::NATIVE_DOUBLE);
+}
+void H5Writer::write(const std::string& name, const std::vector<std::size_t>& dims,
+                     const float* data) {
+  write_array(*file_, out_.target(), name, std::vector<hsize_t>(dims.begin(), dims.end()), data,
+              H5::PredType::NATIVE_FLOAT);
+}
+
+void H5Writer::write_strings(const std::string& name, const std::vector<std::string>& values) {
+  try {
+    ensure_groups(*file_, name, false);
+    H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);
+    type.setCset(H5T_CSET_UTF8);
+    const hsize_t dims[1] = {values.size()};
+    H5::DataSpace space(1, dims);
+    H5::DataSet set = file_->createDataSet(name, type, space);
+    std::vector<const char*> pointers;
+    for (const auto& v : values) pointers.push_back(v.c_str());
+    if (!pointers.empty()) set.write(pointers.data(), type);
+  } catch (const H5::Exception& e) {
+    rethrow(out_.target(), "cannot write dataset '" + name + "'", e);
+  }
+}
+
+void H5Writer::create_group(const std::string& name) {
+  try {
+    ensure_groups(*file_, name, true);
+  } catch (const H5::Exception& e) {
+    rethrow(out_.target(), "cannot create group '" + name + "'", e);
+  }
+}
 
 void H5Writer::write_attribute(const std::string& name, const std::string& value) {
+  write_attribute("/", name, value);
+}
+
+void H5Writer::write_attribute(const std::string& object, const std::string& name,
+                               const std::string& value) {
   try {
-    H5::StrType type(H5::PredType::C_S1, value.size() == 0 ? 1 : value.size());
-    H5::Group root = file_->openGroup("/");
-    H5::Attribute attr = root.createAttribute(name, type, H5::DataSpace(H5S_SCALAR));
+    H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);  // h5py reads it as str
+    type.setCset(H5T_CSET_UTF8);
+    H5::Group group = open_or_create_group(*file_, object);
+    H5::Attribute attr = group.createAttribute(name, type, H5::DataSpace(H5S_SCALAR));
     attr.write(type, value);
   } catch (const H5::Exception& e) {
-    rethrow(out_.target(), "cannot write attribute '" + name + "'", e);
+    rethrow(out_.target(), "cannot write attribute '" + name + "' of '" + object + "'", e);
+  }
+}
+
+void H5Writer::write_attribute(const std::string& object, const std::string& name,
+                               std::int64_t value) {
+  try {
+    H5::Group group = open_or_create_group(*file_, object);
+    H5::Attribute attr =
+        group.createAttribute(name, H5::PredType::STD_I64LE, H5::DataSpace(H5S_SCALAR));
+    attr.write(H5::PredType::NATIVE_INT64, &value);
+  } catch (const H5::Exception& e) {
+    rethrow(out_.target(), "cannot write attribute '" + name + "' of '" + object + "'", e);
+  }
+}
+
+void H5Writer::write_attribute(const std::string& object, const std::string& name, double value) {
+  try {
+    H5::Group group = open_or_create_group(*file_, object);
+    H5::Attribute attr =
+        group.createAttribute(name, H5::PredType::IEEE_F64LE, H5::DataSpace(H5S_SCALAR));
+    attr.write(H5::PredType::NATIVE_DOUBLE, &value);
+  } catch (const H5::Exception& e) {
+    rethrow(out_.target(), "cannot write attribute '" + name + "' of '" + object + "'", e);
   }
 }
 
@@ -100,6 +257,13 @@ void H5Writer::commit() {
 H5Reader::H5Reader(const std::filesystem::path& file) : path_(file) {
   H5::Exception::dontPrint();
   if (!std::filesystem::exists(file)) throw IoError(file.string() + ": file does not exist");
+  bool is_hdf5 = false;
+  try {
+    is_hdf5 = H5::H5File::isHdf5(file.string());
+  } catch (const H5::Exception& e) {
+    rethrow(file, "cannot read file", e);
+  }
+  if (!is_hdf5) throw IoError(file.string() + ": not an HDF5 file (no HDF5 signature)");
   try {
     file_ = std::make_unique<H5::H5File>(file.string(), H5F_ACC_RDONLY);
   } catch (const H5::Exception& e) {
@@ -109,7 +273,36 @@ H5Reader::H5Reader(const std::filesystem::path& file) : path_(file) {
 
 H5Reader::~H5Reader() = default;
 
-bool H5Reader::has(const std::string& name) const { return file_->nameExists(name); }
+bool H5Reader::has(const std::string& name) const {
+  try {
+    return link_exists(*file_, name);
+  } catch (const H5::Exception& e) {
+    rethrow(path_, "cannot look up '" + name + "'", e);
+  }
+}
+
+std::vector<std::size_t> H5Reader::shape(const std::string& name) const {
+  if (!has(name)) throw IoError(path_.string() + ": no dataset '" + name + "'");
+  try {
+    std::vector<hsize_t> dims;
+    open_dataset(*file_, path_, name, dims);
+    return {dims.begin(), dims.end()};
+  } catch (const H5::Exception& e) {
+    rethrow(path_, "cannot open dataset '" + name + "'", e);
+  }
+}
+
+std::vector<std::string> H5Reader::children(const std::string& name) const {
+  if (!has(name)) throw IoError(path_.string() + ": no group '" + name + "'");
+  try {
+    H5::Group group = file_->openGroup(name);
+    std::vector<std::string> out;
+    for (hsize_t i = 0; i < group.getNumObjs(); ++i) out.push_back(group.getObjnameByIdx(i));
+    return out;
+  } catch (const H5::Exception& e) {
+    rethrow(path_, "cannot list group '" + name + "'", e);
+  }
+}
 
 RowMatrixXd H5Reader::read_double(const std::string& name) const {
   return read_matrix<RowMatrixXd>(*file_, path_, name, H5::PredType::NATIVE_DOUBLE);
@@ -120,17 +313,114 @@ RowMatrixXf H5Reader::read_float(const std::string& name) const {
 RowMatrixXi H5Reader::read_int(const std::string& name) const {
   return read_matrix<RowMatrixXi>(*file_, path_, name, H5::PredType::NATIVE_INT);
 }
+std::vector<int> H5Reader::read_ints(const std::string& name) const {
+  return read_values<int>(*file_, path_, name, 1, H5::PredType::NATIVE_INT);
+}
+std::vector<float> H5Reader::read_floats(const std::string& name) const {
+  return read_values<float>(*file_, path_, name, 1, H5::PredType::NATIVE_FLOAT);
+}
+std::vector<double> H5Reader::read_doubles(const std::string& name) const {
+  return read_values<double>(*file_, path_, name, 1, H5::PredType::NATIVE_DOUBLE);
+}
+std::vector<float> H5Reader::read_float_array(const std::string& name,
+                                              std::vector<std::size_t>& dims) const {
+  return read_values<float>(*file_, path_, name, -1, H5::PredType::NATIVE_FLOAT, &dims);
+}
+
+std::vector<std::string> H5Reader::read_strings(const std::string& name) const {
+  if (!has(name)) throw IoError(path_.string() + ": no dataset '" + name + "'");
+  try {
+    std::vector<hsize_t> dims;
+    H5::DataSet set = open_dataset(*file_, path_, name, dims);
+    if (dims.size() != 1) {
+      throw IoError(path_.string() + ": dataset '" + name + "' is not a 1-D list of strings");
+    }
+    if (set.getTypeClass() != H5T_STRING || !set.getStrType().isVariableStr()) {
+      throw IoError(path_.string() + ": dataset '" + name +
+                    "' is not a list of variable-length strings");
+    }
+    H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);
+    type.setCset(set.getStrType().getCset());
+    std::vector<char*> buffer(dims[0], nullptr);
+    std::vector<std::string> out;
+    if (buffer.empty()) return out;
+    set.read(buffer.data(), type);
+    for (char* s : buffer) out.emplace_back(s == nullptr ? "" : s);
+    H5::DataSpace space = set.getSpace();
+    H5Dvlen_reclaim(type.getId(), space.getId(), H5P_DEFAULT, buffer.data());
+    return out;
+  } catch (const H5::Exception& e) {
+    rethrow(path_, "cannot read dataset '" + name + "'", e);
+  }
+}
 
 std::string H5Reader::read_attribute(const std::string& name) const {
+  return read_attribute("/", name);
+}
+
+bool H5Reader::has_attribute(const std::string& object, const std::string& name) const {
   try {
-    H5::Group root = file_->openGroup("/");
-    if (!root.attrExists(name)) throw IoError(path_.string() + ": no attribute '" + name + "'");
-    H5::Attribute attr = root.openAttribute(name);
+    if (object != "/" && !has(object)) return false;
+    return file_->openGroup(object).attrExists(name);
+  } catch (const H5::Exception& e) {
+    rethrow(path_, "cannot look up attribute '" + name + "' of '" + object + "'", e);
+  }
+}
+
+namespace {
+[[noreturn]] void missing_attribute(const std::filesystem::path& path, const std::string& object,
+                                    const std::string& name) {
+  throw IoError(path.string() + ": no attribute '" + name + "'" +
+                (object == "/" ? std::string() : " on '" + object + "'"));
+}
+}  // namespace
+
+std::string H5Reader::read_attribute(const std::string& object, const std::string& name) const {
+  if (!has_attribute(object, name)) missing_attribute(path_, object, name);
+  try {
+    H5::Attribute attr = file_->openGroup(object).openAttribute(name);
+    if (attr.getTypeClass() != H5T_STRING) {
+      throw IoError(path_.string() + ": attribute '" + name + "' of '" + object +
+                    "' is not a string");
+    }
     std::string value;
     attr.read(attr.getStrType(), value);
     return value;
   } catch (const H5::Exception& e) {
-    rethrow(path_, "cannot read attribute '" + name + "'", e);
+    rethrow(path_, "cannot read attribute '" + name + "' of '" + object + "'", e);
+  }
+}
+
+std::int64_t H5Reader::read_int_attribute(const std::string& object,
+                                          const std::string& name) const {
+  if (!has_attribute(object, name)) missing_attribute(path_, object, name);
+  try {
+    H5::Attribute attr = file_->openGroup(object).openAttribute(name);
+    if (attr.getTypeClass() != H5T_INTEGER) {
+      throw IoError(path_.string() + ": attribute '" + name + "' of '" + object +
+                    "' is not an integer");
+    }
+    std::int64_t value = 0;
+    attr.read(H5::PredType::NATIVE_INT64, &value);
+    return value;
+  } catch (const H5::Exception& e) {
+    rethrow(path_, "cannot read attribute '" + name + "' of '" + object + "'", e);
+  }
+}
+
+double H5Reader::read_double_attribute(const std::string& object, const std::string& name) const {
+  if (!has_attribute(object, name)) missing_attribute(path_, object, name);
+  try {
+    H5::Attribute attr = file_->openGroup(object).openAttribute(name);
+    if (attr.getTypeClass() != H5T_FLOAT && attr.getTypeClass() != H5T_INTEGER) {
+      throw IoError(path_.string() + ": attribute '" + name + "' of '" + object +
+                    "' is not a number");
+    }
+    double value = 0;
+    attr.read(H5::PredType::NATIVE_DOUBLE, &value);
+    return value;
+  } catch (const H5::Exception& e) {
+    rethrow(path_, "cannot read attribute '" + name + "' of '" + object + "'", e);
   }
 }
 

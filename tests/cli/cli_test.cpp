@@ -124,5 +124,34 @@ TEST(Cli, DistanceOfARealCharacterToHdf5AndCsv) {
   EXPECT_FALSE(std::filesystem::exists(dir / "D.txt"));
 }
 
+TEST(Cli, PrepareAndDatasetInfoOnTheMinetestConfig) {
+  TempDir dir;
+  const std::string out = (dir / "minetest.h5").string();
+  const Result r = run("prepare configs/datasets/minetest.yaml output=" + out +
+                       " distances.0.resolution=32 --threads 2");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("prepared " + out + ": 1 characters (1 computed, 0 reused), 0 excluded"),
+            std::string::npos) << r.out;
+  EXPECT_FALSE(std::filesystem::exists(out + ".partial"));
+
+  const Result info = run("dataset-info " + out);
+  ASSERT_EQ(info.status, 0) << info.err;
+  for (const std::string part :
+       {"format_version 1", "characters: 1", "character: ", "168 original", "6 joints, 10 bones",
+        "distances: euclidean (K=3), hollow_dist (K=3)", "skeleton minetest_player",
+        "licence CC-BY-SA-3.0", "splits: 0", "excluded: 0"}) {
+    EXPECT_NE(info.out.find(part), std::string::npos) << part << "\n" << info.out;
+  }
+
+  const Result foreign = run("dataset-info configs/datasets/minetest.yaml");
+  EXPECT_EQ(foreign.status, 1);
+  EXPECT_NE(foreign.err.find("skinlab: error: configs/datasets/minetest.yaml: not an HDF5 file"),
+            std::string::npos) << foreign.err;
+  const Result typo = run("prepare configs/datasets/minetest.yaml output=" + out +
+                          " preprocess.topk=2");
+  EXPECT_EQ(typo.status, 1);
+  EXPECT_NE(typo.err.find("preprocess.topk: unknown field"), std::string::npos) << typo.err;
+}
+
 }  // namespace
 }  // namespace skinlab

@@ -61,7 +61,7 @@ TEST(H5, BadFilesAreNamed) {
   TempDir dir;
   expect_error<IoError>([&] { H5Reader(dir / "absent.h5"); }, {"absent.h5: file does not exist"});
   const auto text = dir.write("text.h5", "not hdf5");
-  expect_error<IoError>([&] { H5Reader r(text); }, {"text.h5: not a readable HDF5 file"});
+  expect_error<IoError>([&] { H5Reader r(text); }, {"text.h5: not an HDF5 file"});
 }
 
 }  // namespace

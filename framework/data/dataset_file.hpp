@@ -1,0 +1,109 @@
+#pragma once
+/// \file
+/// The one preprocessed dataset file (layout: datasets/FORMAT.md). A `Dataset` holds characters
+/// preprocessed as HeterSkinNet Sec. 4.1 (normalised, merged, subdivided; see preprocess.hpp),
+/// the characters a builder or the preprocessing excluded with their reasons, and named splits
+/// as index lists into the character list.
+///
+/// write_dataset writes through a temporary file renamed into place (H5Writer), so a crash never
+/// leaves a partial file under the target name. read_dataset validates every shape and index
+/// range and throws IoError naming the file and the dataset (HDF5 path) that is wrong.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "datasets/source.hpp"
+#include "framework/data/h5.hpp"
+#include "framework/geometry/skin_weights.hpp"
+
+namespace skinlab::data {
+
+/// Version of the layout written by this build; a file with another version is rejected.
+inline constexpr std::int64_t kFormatVersion = 1;
+
+/// What one distance type gives a character (HeterSkinNet Sec. 3.2: the top-K candidate bones of
+/// every vertex and 1/D as a vertex attribute). K is min(top_k, #B).
+struct DistanceData {
+  RowMatrixXf D;              ///< #V×#B vertex–bone distance, metres (normalised 1 m frame)
+  RowMatrixXi topk_index;     ///< #V×K bone indices, nearest first (ties: lower bone index)
+  RowMatrixXf topk_distance;  ///< #V×K D at those bones, ascending along each row
+  /// #V×K artist weight of each candidate bone (bone-level rule in preprocess.hpp): in [0, 1],
+  /// rows sum to ≤ 1 (the weight on bones outside the top K is dropped, as in the paper).
+  RowMatrixXf targets;
+};
+
+/// One animation clip: joint transforms in the normalised frame of the character.
+struct AnimationData {
+  std::string name;
+  double fps = 0;  ///< frames per second, 0 when unknown
+  /// #frames × #J × 12 float32: the first three rows of joint j's 4×4 global transform at a
+  /// frame, row-major ([R | t], t in metres), in the normalised frame.
+  std::vector<float> frames;
+  int num_frames = 0;
+  /// #J × 12 float32: bind-pose global transforms, same layout.
+  std::vector<float> bind;
+};
+
+/// A character after preprocessing, everything in the normalised frame (Y up, 1 m tall).
+struct PreparedCharacter {
+  std::string name;  ///< unique in the dataset; an HDF5 name (no '/', not "." or "")
+  RowMatrixXd V;     ///< #V×3 vertex positions, metres (after merging and subdivision)
+  RowMatrixXi F;     ///< #F×3 triangle vertex indices into V
+  std::vector<std::string> joint_names;  ///< #J
+  std::vector<int> parents;              ///< #J parent index, −1 for the root
+  RowMatrixXd joints;                    ///< #J×3 joint positions, metres
+  RowMatrixXi bones;                     ///< #B×2 (start, end) joints; start = end: helper bone
+  geometry::SparseWeights weights;       ///< #V×#J artist weights, rows sum to 1
+  /// #V_orig: the vertex of V that every vertex of the source mesh became (merge map; the first
+  /// vertices of V are the merged originals, subdivision only appends).
+  std::vector<int> vertex_map;
+  /// 4×4 similarity [s·R, t; 0 0 0 1] from the source file's frame to the normalised frame.
+  Eigen::Matrix4d normalisation = Eigen::Matrix4d::Identity();
+  int subdivision_levels = 0;
+  /// Per distance registry key (e.g. "hollow_dist").
+  std::map<std::string, DistanceData> distances;
+  RowMatrixXi one_ring_edges;  ///< #E×2 directed edges (i, j), both directions of every edge
+  RowMatrixXi geodesic_edges;  ///< #E_g×2 directed edges (i, j), geodesic radius 0.06, cap 10
+  /// Uniform Laplacian L = D − A (laplacian.hpp) as #N triplets, row-major order.
+  RowMatrixXi laplacian_indices;         ///< #N×2 (row, column)
+  std::vector<double> laplacian_values;  ///< #N
+  // Provenance (SourceCharacter).
+  std::string source, path, licence, attribution, skeleton;
+  std::vector<AnimationData> animations;
+
+  int num_vertices() const { return static_cast<int>(V.rows()); }
+  int num_joints() const { return static_cast<int>(joint_names.size()); }
+  int num_bones() const { return static_cast<int>(bones.rows()); }
+};
+
+/// Index lists into Dataset::characters.
+struct Split {
+  std::vector<int> train, val, test;
+};
+
+struct Dataset {
+  std::vector<PreparedCharacter> characters;  ///< order of /character_names
+  std::map<std::string, Split> splits;
+  std::vector<datasets::Excluded> excluded;
+  std::string git_commit = "unknown";  ///< skinlab commit that wrote the file ("-dirty": modified)
+  /// The resolved `preprocess:` and `distances:` config (YAML) the characters were made with;
+  /// `skinlab prepare` reuses a partial character file only when this matches.
+  std::string preparation;
+};
+
+/// Writes `dataset` to `file` atomically. Throws IoError for an invalid character name or a
+/// duplicate name, and on any HDF5 failure (naming the file and the dataset).
+void write_dataset(const std::filesystem::path& file, const Dataset& dataset);
+
+/// Reads and validates a dataset file. Throws IoError naming the file and the HDF5 path for: a
+/// missing file, a file that is not HDF5 or is truncated, a missing `format_version` (a foreign
+/// file) or a version other than kFormatVersion, a missing dataset, a wrong shape, an index out
+/// of range (faces ≥ #V, bones or CSR columns ≥ #J, parents, top-K ≥ #B, edges, Laplacian,
+/// vertex map, split indices ≥ #characters), inconsistent CSR arrays and non-finite values.
+Dataset read_dataset(const std::filesystem::path& file);
+
+}  // namespace skinlab::data

@@ -1,0 +1,67 @@
+#pragma once
+/// \file
+/// `skinlab prepare`: builders → preprocessing (preprocess.hpp) → one dataset file
+/// (dataset_file.hpp), in parallel over characters, resumable and safe to kill at any time.
+///
+/// Config (configs/datasets/<name>.yaml):
+///
+///     sources:            # dataset registry nodes, read in order
+///       - {type: folder, path: ..., licence: ..., attribution: ..., skeleton: ...}
+///     preprocess: {...}   # PreprocessOptions (all optional)
+///     distances:          # distance registry nodes; each type at most once
+///       - {type: hollow_dist, resolution: 88}
+///     output: results/datasets/name.h5
+///
+/// Resumability. Each character is preprocessed into `<output>.partial/<name>.h5` (a dataset file
+/// holding that one character), written through a temporary file and renamed into place, so a
+/// file under its final name is complete. A later run reuses such a file when it reads and
+/// validates and was made with the same `preprocess:` and `distances:` config (the `preparation`
+/// attribute); otherwise the character is recomputed. When every character is done, the
+/// per-character files are merged into `output` (again through a temporary file) and the partial
+/// directory is removed (unless keep_partial). Killing the process at any point therefore loses
+/// at most the characters in flight.
+
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "datasets/source.hpp"
+#include "framework/core/config.hpp"
+#include "framework/data/preprocess.hpp"
+
+namespace skinlab::data {
+
+struct PrepareConfig {
+  std::vector<config::Node> sources;  ///< dataset registry nodes
+  PreprocessOptions preprocess;
+  std::vector<config::Node> distances;  ///< distance registry nodes
+  std::filesystem::path output;
+  /// The resolved `preprocess:` and `distances:` sections as YAML (Dataset::preparation).
+  std::string preparation;
+
+  /// Decodes and validates the whole config, including every source and distance node (their
+  /// plug-ins are constructed once here), before any work starts.
+  static PrepareConfig from(const config::Config& config);
+};
+
+struct PrepareOptions {
+  int threads = 0;            ///< characters (and the TBB work inside them); 0: every core
+  bool keep_partial = false;  ///< keep `<output>.partial/` after the merge
+  bool progress = true;       ///< report progress on stderr (framework/core/progress.hpp)
+};
+
+struct PrepareReport {
+  std::filesystem::path output;
+  std::size_t characters = 0;                ///< characters in the output file
+  std::size_t computed = 0;                  ///< preprocessed in this run
+  std::size_t reused = 0;                    ///< taken from an existing partial file
+  std::vector<datasets::Excluded> excluded;  ///< by builders and by preprocessing
+  double seconds = 0;
+};
+
+/// Runs the pipeline of the file comment. A character that fails preprocessing is excluded with
+/// its reason (not fatal); a source that cannot be read at all, or a failure to write, throws.
+PrepareReport prepare_dataset(const PrepareConfig& config, const PrepareOptions& options = {});
+
+}  // namespace skinlab::data

@@ -1,0 +1,206 @@
+#include "framework/data/preprocess.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <numeric>
+
+#include "framework/core/error.hpp"
+#include "framework/geometry/average_vertex_data.hpp"
+#include "framework/geometry/geodesic_neighbours.hpp"
+#include "framework/geometry/laplacian.hpp"
+#include "framework/geometry/merge_vertices.hpp"
+#include "framework/geometry/normalize.hpp"
+#include "framework/geometry/one_ring.hpp"
+#include "framework/geometry/subdivide.hpp"
+
+namespace skinlab::data {
+
+PreprocessOptions PreprocessOptions::from(const config::Node& node) {
+  PreprocessOptions o;
+  config::Fields f(node, "preprocess", {});
+  f.optional("merge_tolerance", o.merge_tolerance);
+  f.optional("min_vertices", o.min_vertices);
+  f.optional("max_vertices", o.max_vertices);
+  f.optional("top_k", o.top_k);
+  f.optional("geodesic_radius", o.geodesic_radius);
+  f.optional("geodesic_max_neighbours", o.geodesic_max_neighbours);
+  f.check(o.merge_tolerance >= 0, "merge_tolerance", "must be ≥ 0");
+  f.check(o.min_vertices >= 0, "min_vertices", "must be ≥ 0");
+  f.check(o.max_vertices >= o.min_vertices, "max_vertices", "must be ≥ min_vertices");
+  f.check(o.top_k >= 1, "top_k", "must be ≥ 1");
+  f.check(o.geodesic_radius > 0, "geodesic_radius", "must be positive");
+  f.check(o.geodesic_max_neighbours >= 0, "geodesic_max_neighbours", "must be ≥ 0");
+  f.finish();
+  return o;
+}
+
+void top_k_bones(const Eigen::MatrixXd& D, int k, RowMatrixXi& index, RowMatrixXf& distance) {
+  if (k < 1) throw Error("top_k_bones: k must be ≥ 1, got " + std::to_string(k));
+  const int nb = static_cast<int>(D.cols());
+  const int kk = std::min(k, nb);
+  index.resize(D.rows(), kk);
+  distance.resize(D.rows(), kk);
+  std::vector<int> order(nb);
+  for (Eigen::Index v = 0; v < D.rows(); ++v) {
+    std::iota(order.begin(), order.end(), 0);
+    std::partial_sort(order.begin(), order.begin() + kk, order.end(),
+                      [&](int a, int b) { return D(v, a) != D(v, b) ? D(v, a) < D(v, b) : a < b; });
+    for (int j = 0; j < kk; ++j) {
+      index(v, j) = order[j];
+      distance(v, j) = static_cast<float>(D(v, order[j]));
+    }
+  }
+}
+
+Eigen::MatrixXd bone_weights(const geometry::SparseWeights& W, const geometry::Skeleton& skeleton,
+                             const Eigen::MatrixXd& D) {
+  const auto bones = skeleton.bones();
+  std::vector<std::vector<int>> starting(skeleton.num_joints());
+  for (std::size_t b = 0; b < bones.size(); ++b)
+    starting[bones[b].start].push_back(static_cast<int>(b));
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(W.rows(), static_cast<Eigen::Index>(bones.size()));
+  for (Eigen::Index v = 0; v < W.rows(); ++v) {
+    for (geometry::SparseWeights::InnerIterator it(W, v); it; ++it) {
+      int best = -1;
+      for (int b : starting[it.col()]) {
+        if (best < 0 || D(v, b) < D(v, best)) best = b;  // strict: ties keep the lower index
+      }
+      if (best >= 0) out(v, best) += it.value();
+    }
+  }
+  return out;
+}
+
+namespace {
+
+RowMatrixXi edge_rows(const Eigen::Matrix2Xi& edges) { return edges.transpose(); }
+
+std::vector<float> rows_12(const Eigen::Matrix4d& m) {
+  std::vector<float> out;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) out.push_back(static_cast<float>(m(r, c)));
+  return out;
+}
+
+AnimationData convert(const datasets::Animation& a, const Eigen::Matrix4d& sim, int num_joints,
+                      const std::string& where) {
+  // Conjugating by the similarity keeps LBS exact in the normalised frame:
+  // (S·T·S⁻¹)(S·B·S⁻¹)⁻¹ = S·(T·B⁻¹)·S⁻¹.
+  const Eigen::Matrix4d inv = sim.inverse();
+  AnimationData out;
+  out.name = a.name;
+  out.fps = a.fps;
+  out.num_frames = static_cast<int>(a.frames.size());
+  if (static_cast<int>(a.bind.size()) != num_joints) {
+    throw Error(where + ": animation '" + a.name + "' has " + std::to_string(a.bind.size()) +
+                " bind transforms for " + std::to_string(num_joints) + " joints");
+  }
+  for (const auto& frame : a.frames) {
+    if (static_cast<int>(frame.size()) != num_joints) {
+      throw Error(where + ": animation '" + a.name + "' has a frame with " +
+                  std::to_string(frame.size()) + " joints, expected " + std::to_string(num_joints));
+    }
+    for (const auto& t : frame) {
+      const auto m = rows_12(sim * t.matrix() * inv);
+      out.frames.insert(out.frames.end(), m.begin(), m.end());
+    }
+  }
+  for (const auto& t : a.bind) {
+    const auto m = rows_12(sim * t.matrix() * inv);
+    out.bind.insert(out.bind.end(), m.begin(), m.end());
+  }
+  return out;
+}
+
+}  // namespace
+
+PreparedCharacter preprocess(const datasets::SourceCharacter& source,
+                             const std::vector<NamedDistance>& distances,
+                             const PreprocessOptions& options) {
+  geometry::Character c = source.character;
+  const std::string where = c.name + " (" + source.path + ")";
+  if (!c.has_weights()) throw Error(where + ": character has no skin weights");
+
+  // 1. Normalise.
+  const geometry::Similarity sim = geometry::normalize(c);
+
+  // 2. Merge co-located vertices; average their weights.
+  const geometry::MergedMesh merged = geometry::merge_vertices(c.mesh, {options.merge_tolerance});
+  const geometry::SparseWeights W_merged =
+      geometry::average_vertex_data(c.weights, merged.old_to_new, merged.mesh.num_vertices());
+
+  // 3. Subdivide small meshes; interpolate weights linearly.
+  const geometry::SubdividedMesh sub =
+      geometry::subdivide(merged.mesh, {options.min_vertices, options.max_vertices});
+  geometry::SparseWeights W = (sub.S * W_merged).pruned();
+  W.makeCompressed();
+  const geometry::Mesh& mesh = sub.mesh;
+
+  PreparedCharacter out;
+  out.name = c.name;
+  out.V = mesh.V;
+  out.F = mesh.F;
+  out.joint_names = c.skeleton.names;
+  out.parents = c.skeleton.parents;
+  out.joints = c.skeleton.positions;
+  const auto bones = c.skeleton.bones();
+  out.bones.resize(static_cast<Eigen::Index>(bones.size()), 2);
+  for (std::size_t b = 0; b < bones.size(); ++b) out.bones.row(b) << bones[b].start, bones[b].end;
+  out.weights = W;
+  out.vertex_map.assign(merged.old_to_new.data(),
+                        merged.old_to_new.data() + merged.old_to_new.size());
+  out.normalisation = sim.matrix();
+  out.subdivision_levels = sub.levels;
+
+  // 4. Distances, top-K candidates and bone-level targets.
+  for (const auto& named : distances) {
+    const Eigen::MatrixXd D = named.distance->compute(mesh, c.skeleton);
+    if (D.rows() != mesh.V.rows() || D.cols() != static_cast<Eigen::Index>(bones.size())) {
+      throw Error(where + ": distance '" + named.type + "' returned " + std::to_string(D.rows()) +
+                  "×" + std::to_string(D.cols()) + ", expected #V×#B");
+    }
+    DistanceData d;
+    d.D = D.cast<float>();
+    // Top-K and targets from D as stored (float32), so that ties and orders recomputed from the
+    // file agree with the stored top-K and targets.
+    const Eigen::MatrixXd Ds = d.D.cast<double>();
+    top_k_bones(Ds, options.top_k, d.topk_index, d.topk_distance);
+    const Eigen::MatrixXd Wb = bone_weights(W, c.skeleton, Ds);
+    d.targets.resize(D.rows(), d.topk_index.cols());
+    for (Eigen::Index v = 0; v < D.rows(); ++v) {
+      for (Eigen::Index k = 0; k < d.topk_index.cols(); ++k) {
+        d.targets(v, k) = static_cast<float>(Wb(v, d.topk_index(v, k)));
+      }
+    }
+    out.distances.emplace(named.type, std::move(d));
+  }
+
+  // 5. Graph structure and the Laplacian.
+  out.one_ring_edges = edge_rows(geometry::one_ring(mesh).edges);
+  geometry::GeodesicOptions geo;
+  geo.radius = options.geodesic_radius;
+  geo.max_neighbours = options.geodesic_max_neighbours;
+  out.geodesic_edges = edge_rows(geometry::geodesic_neighbours(mesh, geo).edges);
+  const Eigen::SparseMatrix<double, Eigen::RowMajor> L = geometry::laplacian(mesh);
+  out.laplacian_indices.resize(L.nonZeros(), 2);
+  out.laplacian_values.reserve(L.nonZeros());
+  Eigen::Index n = 0;
+  for (Eigen::Index i = 0; i < L.outerSize(); ++i) {
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(L, i); it; ++it, ++n) {
+      out.laplacian_indices.row(n) << static_cast<int>(it.row()), static_cast<int>(it.col());
+      out.laplacian_values.push_back(it.value());
+    }
+  }
+
+  out.source = source.source;
+  out.path = source.path;
+  out.licence = source.licence;
+  out.attribution = source.attribution;
+  out.skeleton = source.skeleton;
+  for (const auto& a : source.animations) {
+    out.animations.push_back(convert(a, sim.matrix(), c.skeleton.num_joints(), where));
+  }
+  return out;
+}
+
+}  // namespace skinlab::data

@@ -1,0 +1,72 @@
+#pragma once
+/// \file
+/// Preprocessing of one character as HeterSkinNet (Pan et al. 2021) Sec. 4.1, plus everything a
+/// network needs per character (Sec. 3.2–3.4), computed once and stored in the dataset file:
+///
+/// 1. normalise: Y up, 1 m tall, feet at y = 0, x/z centred (geometry/normalize.hpp); the
+///    similarity is kept (PreparedCharacter::normalisation);
+/// 2. merge vertices at the same position (geometry/merge_vertices.hpp); weights of merged
+///    vertices are averaged (equal at seams, Sec. 4.1); the original → merged map is kept;
+/// 3. subdivide meshes below `min_vertices` into [min_vertices, max_vertices] (1K–5K in the
+///    paper; geometry/subdivide.hpp) with weights interpolated linearly, W' = S · W (rows still
+///    sum to 1 because the rows of S do);
+/// 4. per distance type of the config: D (#V×#B), the top-K candidate bones per vertex (K = 3,
+///    Sec. 3.2) with their distances, and bone-level targets over the K candidates;
+/// 5. one-ring edges (Eq. 2, N_m), geodesic neighbour edges (radius 0.06, at most 10; N_g) and
+///    the uniform Laplacian of the smoothing loss (Sec. 3.4, Eq. 6) as triplets.
+///
+/// Bone-level targets (RigNet's rule, Xu et al. 2020, gen_dataset.py): artist weights are per
+/// joint; a bone (start → end) carries its start joint's weight. A joint with several bones
+/// starting at it (a branching joint: spine → two shoulders and the neck) gives its whole weight
+/// to the one of those bones nearest to the vertex under the same distance type (ties: lower bone
+/// index); a leaf joint's only bone is its helper bone. This yields a #V×#B bone weight matrix
+/// with rows summing to 1; targets(v, k) is its entry at topk_index(v, k), so a target row sums
+/// to ≤ 1 (the weight on bones outside the K candidates is dropped, as the paper's network can
+/// only predict the K candidates). Top-K and the choice of bone use D rounded to float32 as
+/// stored, so both can be recomputed exactly from the file.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "datasets/source.hpp"
+#include "framework/core/config.hpp"
+#include "framework/data/dataset_file.hpp"
+#include "framework/distances/distance.hpp"
+
+namespace skinlab::data {
+
+struct PreprocessOptions {
+  double merge_tolerance = 0.0;   ///< metres after normalisation; 0: bit-identical positions
+  int min_vertices = 1000;        ///< subdivide below this many vertices (Sec. 4.1: 1K)
+  int max_vertices = 5000;        ///< never subdivide beyond this many (Sec. 4.1: 5K)
+  int top_k = 3;                  ///< candidate bones per vertex (Sec. 3.2: K = 3)
+  double geodesic_radius = 0.06;  ///< metres (Sec. 3.3)
+  int geodesic_max_neighbours = 10;
+
+  /// Decodes a `preprocess:` map (every field optional); errors name the file, line and key.
+  static PreprocessOptions from(const config::Node& node);
+};
+
+/// A distance plug-in with the registry key it is stored under.
+struct NamedDistance {
+  std::string type;
+  std::shared_ptr<const distances::Distance> distance;
+};
+
+/// Top-K of every row of D (#V×#B): #V×K bone indices sorted by (distance, index) and the
+/// distances, K = min(k, #B). Requires k ≥ 1.
+void top_k_bones(const Eigen::MatrixXd& D, int k, RowMatrixXi& index, RowMatrixXf& distance);
+
+/// #V×#B bone weights from #V×#J joint weights by the rule of the file comment, using D
+/// (#V×#B) to choose among the bones starting at a joint.
+Eigen::MatrixXd bone_weights(const geometry::SparseWeights& W, const geometry::Skeleton& skeleton,
+                             const Eigen::MatrixXd& D);
+
+/// Runs steps 1–5 on `source` (which must carry weights). Throws (GeometryError, IoError) with
+/// the character's name in the message when any step fails.
+PreparedCharacter preprocess(const datasets::SourceCharacter& source,
+                             const std::vector<NamedDistance>& distances,
+                             const PreprocessOptions& options = {});
+
+}  // namespace skinlab::data

@@ -1,0 +1,216 @@
+// The HDF5 dataset format (datasets/FORMAT.md): round trip, compression, and the reader's
+// errors on truncated, foreign, wrong-version and inconsistent files.
+
+#include "framework/data/dataset_file.hpp"
+
+#include <H5Cpp.h>
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+
+#include "framework/core/atomic_file.hpp"
+#include "tests/data/data_fixtures.hpp"
+#include "tests/test_util.hpp"
+
+namespace skinlab {
+namespace {
+
+using testing::expect_error;
+using testing::TempDir;
+
+data::Dataset tiny_dataset() {
+  data::Dataset d;
+  d.characters = {testing::tiny_character("alpha"), testing::tiny_character("beta")};
+  d.characters[1].animations.clear();
+  d.characters[1].distances["hollow_dist"] = d.characters[1].distances["euclidean"];
+  d.splits["random"] = {{0}, {}, {1}};
+  d.splits["by_skeleton"] = {{1}, {0}, {}};
+  d.excluded = {{"folder", "bad.fbx", "bad.fbx: cannot read"}, {"zeroad", "x.pmd", "no bones"}};
+  d.git_commit = "0123abcd";
+  d.preparation = "preprocess: {}\ndistances: [{type: euclidean}]\n";
+  return d;
+}
+
+void expect_equal(const data::PreparedCharacter& a, const data::PreparedCharacter& b) {
+  EXPECT_EQ(a.name, b.name);
+  EXPECT_EQ(a.V, b.V);
+  EXPECT_EQ(a.F, b.F);
+  EXPECT_EQ(a.joint_names, b.joint_names);
+  EXPECT_EQ(a.parents, b.parents);
+  EXPECT_EQ(a.joints, b.joints);
+  EXPECT_EQ(a.bones, b.bones);
+  EXPECT_TRUE(Eigen::MatrixXd(a.weights).isApprox(Eigen::MatrixXd(b.weights), 1e-7));
+  EXPECT_EQ(a.weights.nonZeros(), b.weights.nonZeros());
+  EXPECT_EQ(a.vertex_map, b.vertex_map);
+  EXPECT_EQ(a.normalisation, b.normalisation);
+  EXPECT_EQ(a.subdivision_levels, b.subdivision_levels);
+  ASSERT_EQ(a.distances.size(), b.distances.size());
+  for (const auto& [type, d] : a.distances) {
+    const auto& e = b.distances.at(type);
+    EXPECT_EQ(d.D, e.D) << type;
+    EXPECT_EQ(d.topk_index, e.topk_index);
+    EXPECT_EQ(d.topk_distance, e.topk_distance);
+    EXPECT_EQ(d.targets, e.targets);
+  }
+  EXPECT_EQ(a.one_ring_edges, b.one_ring_edges);
+  EXPECT_EQ(a.geodesic_edges, b.geodesic_edges);
+  EXPECT_EQ(a.laplacian_indices, b.laplacian_indices);
+  EXPECT_EQ(a.laplacian_values, b.laplacian_values);
+  EXPECT_EQ(a.source, b.source);
+  EXPECT_EQ(a.path, b.path);
+  EXPECT_EQ(a.licence, b.licence);
+  EXPECT_EQ(a.attribution, b.attribution);
+  EXPECT_EQ(a.skeleton, b.skeleton);
+  ASSERT_EQ(a.animations.size(), b.animations.size());
+  for (std::size_t i = 0; i < a.animations.size(); ++i) {
+    EXPECT_EQ(a.animations[i].name, b.animations[i].name);
+    EXPECT_EQ(a.animations[i].fps, b.animations[i].fps);
+    EXPECT_EQ(a.animations[i].num_frames, b.animations[i].num_frames);
+    EXPECT_EQ(a.animations[i].frames, b.animations[i].frames);
+    EXPECT_EQ(a.animations[i].bind, b.animations[i].bind);
+  }
+}
+
+TEST(DatasetFile, RoundTrip) {
+  TempDir dir;
+  const auto d = tiny_dataset();
+  data::write_dataset(dir / "d.h5", d);
+  const auto r = data::read_dataset(dir / "d.h5");
+  ASSERT_EQ(r.characters.size(), 2u);
+  expect_equal(d.characters[0], r.characters[0]);
+  expect_equal(d.characters[1], r.characters[1]);
+  EXPECT_EQ(r.git_commit, d.git_commit);
+  EXPECT_EQ(r.preparation, d.preparation);
+  ASSERT_EQ(r.splits.size(), 2u);
+  EXPECT_EQ(r.splits.at("random").train, std::vector<int>{0});
+  EXPECT_EQ(r.splits.at("random").test, std::vector<int>{1});
+  EXPECT_EQ(r.splits.at("by_skeleton").val, std::vector<int>{0});
+  ASSERT_EQ(r.excluded.size(), 2u);
+  EXPECT_EQ(r.excluded[1].source, "zeroad");
+  EXPECT_EQ(r.excluded[1].path, "x.pmd");
+  EXPECT_EQ(r.excluded[1].reason, "no bones");
+}
+
+TEST(DatasetFile, RealCharacterArraysAreChunkedAndCompressed) {
+  TempDir dir;
+  data::Dataset d;
+  auto c = testing::tiny_character("big");
+  c.distances.at("euclidean").D = data::RowMatrixXf::Random(4, 400);  // 1600 ≥ kChunkThreshold
+  d.characters.push_back(c);
+  data::write_dataset(dir / "d.h5", d);
+  H5::H5File file((dir / "d.h5").string(), H5F_ACC_RDONLY);
+  const auto big = file.openDataSet("/characters/big/distances/euclidean/D").getCreatePlist();
+  EXPECT_EQ(big.getLayout(), H5D_CHUNKED);
+  EXPECT_GE(big.getNfilters(), 1);
+  const auto small = file.openDataSet("/characters/big/F").getCreatePlist();
+  EXPECT_EQ(small.getLayout(), H5D_CONTIGUOUS);
+}
+
+TEST(DatasetFile, ForeignAndBrokenFilesAreNamed) {
+  TempDir dir;
+  expect_error<IoError>([&] { data::read_dataset(dir / "none.h5"); },
+                        {"none.h5", "does not exist"});
+  const auto text = dir.write("text.h5", "hello, not HDF5\n");
+  expect_error<IoError>([&] { data::read_dataset(text); }, {"text.h5", "not an HDF5 file"});
+
+  {  // An HDF5 file of someone else: no format_version.
+    data::H5Writer w(dir / "foreign.h5");
+    w.write("matrix", data::RowMatrixXd(data::RowMatrixXd::Zero(2, 2)));
+    w.commit();
+  }
+  expect_error<IoError>([&] { data::read_dataset(dir / "foreign.h5"); },
+                        {"foreign.h5", "not a skinlab dataset", "format_version"});
+  {
+    data::H5Writer w(dir / "future.h5");
+    w.write_attribute("/", "format_version", std::int64_t{2});
+    w.commit();
+  }
+  expect_error<IoError>([&] { data::read_dataset(dir / "future.h5"); },
+                        {"future.h5", "format_version 2 is not supported", "version 1"});
+
+  // Truncated: a real dataset cut at half its size (as a crash during a copy would leave it).
+  data::Dataset d = tiny_dataset();
+  d.characters[0].distances.at("euclidean").D = data::RowMatrixXf::Random(4, 4000);
+  data::write_dataset(dir / "full.h5", d);
+  const auto size = std::filesystem::file_size(dir / "full.h5");
+  std::filesystem::copy_file(dir / "full.h5", dir / "cut.h5");
+  std::filesystem::resize_file(dir / "cut.h5", size / 2);
+  expect_error<IoError>([&] { data::read_dataset(dir / "cut.h5"); }, {"cut.h5", "truncated"});
+}
+
+TEST(DatasetFile, OutOfRangeIndicesNameTheDataset) {
+  TempDir dir;
+  data::Dataset d = tiny_dataset();
+  d.characters[1].F(1, 2) = 4;  // #V = 4
+  data::write_dataset(dir / "f.h5", d);
+  expect_error<IoError>([&] { data::read_dataset(dir / "f.h5"); },
+                        {"f.h5", "'/characters/beta/F'", "entry 5 = 4", "vertex"});
+
+  d = tiny_dataset();
+  d.characters[0].distances.at("euclidean").topk_index(3, 1) = 4;  // #B = 4
+  data::write_dataset(dir / "k.h5", d);
+  expect_error<IoError>([&] { data::read_dataset(dir / "k.h5"); },
+                        {"'/characters/alpha/distances/euclidean/topk_index'", "bone"});
+
+  d = tiny_dataset();
+  d.characters[0].bones(2, 1) = 3;  // #J = 3
+  data::write_dataset(dir / "b.h5", d);
+  expect_error<IoError>([&] { data::read_dataset(dir / "b.h5"); },
+                        {"'/characters/alpha/bones'", "joint"});
+
+  // Inconsistent CSR: overwrite indptr in place with a decreasing one.
+  d = tiny_dataset();
+  data::write_dataset(dir / "w.h5", d);
+  {
+    H5::H5File file((dir / "w.h5").string(), H5F_ACC_RDWR);
+    const int bad[5] = {0, 3, 2, 5, 6};
+    file.openDataSet("/characters/alpha/weights/indptr").write(bad, H5::PredType::NATIVE_INT);
+  }
+  expect_error<IoError>([&] { data::read_dataset(dir / "w.h5"); },
+                        {"'/characters/alpha/weights/indptr'", "decreases at row 1"});
+
+  testing::expect_error<IoError>(
+      [&] {
+        data::Dataset bad = tiny_dataset();
+        bad.splits["random"].test = {2};
+        data::write_dataset(dir / "s.h5", bad);
+      },
+      {"split 'random' index 2"});
+  EXPECT_FALSE(std::filesystem::exists(dir / "s.h5"));
+}
+
+TEST(DatasetFile, ReadableByH5py) {
+  if (std::system("dpkg -s python3-h5py >/dev/null 2>&1") != 0) {
+    GTEST_SKIP()
+        << "python3-h5py is not installed (dpkg -s python3-h5py), so /usr/bin/python3 cannot "
+           "read the file with h5py here; install it to run this test";
+  }
+  TempDir dir;
+  data::Dataset d = tiny_dataset();
+  d.characters[0].distances.at("euclidean").D = data::RowMatrixXf::Random(4, 400);  // compressed
+  data::write_dataset(dir / "d.h5", d);
+  const auto out = dir / "h5py.txt";
+  const std::string script =
+      "import h5py, numpy as np, sys\n"
+      "f = h5py.File(sys.argv[1], 'r')\n"
+      "c = f['characters/alpha']\n"
+      "names = [n.decode() if isinstance(n, bytes) else n for n in f['character_names'][()]]\n"
+      "ip, ix, w = (c['weights/' + k][()] for k in ('indptr', 'indices', 'values'))\n"
+      "rows = np.add.reduceat(w, ip[:-1])\n"
+      "print(int(f.attrs['format_version']), names, c['V'].shape, c['F'][1].tolist(),\n"
+      "      c['distances/euclidean/D'].shape, c['distances/euclidean/D'].compression,\n"
+      "      np.allclose(rows, 1), list(f['splits/random/test'][()]),\n"
+      "      c.attrs['licence'], c['animations/0/frames'].shape)\n";
+  const auto py = dir.write("check.py", script);
+  const std::string command = "/usr/bin/python3 '" + py.string() + "' '" + (dir / "d.h5").string() +
+                              "' >'" + out.string() + "' 2>&1";
+  const int status = std::system(command.c_str());
+  const std::string printed = read_file(out);
+  ASSERT_EQ(status, 0) << printed;
+  EXPECT_EQ(printed,
+            "1 ['alpha', 'beta'] (4, 3) [1, 3, 2] (4, 400) gzip True [1] CC0-1.0 (2, 3, 12)\n");
+}
+
+}  // namespace
+}  // namespace skinlab
