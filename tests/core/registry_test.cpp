@@ -107,7 +107,7 @@ TEST(Registry, ExactKeysOfEveryCategory) {
       {"model", {}},
       {"loss", {"kl", "laplacian_smoothing", "mse", "soft_cross_entropy"}},
       {"metric", {}},
-      {"dataset", {"cube2", "folder", "nexuiz"}},
+      {"dataset", {"cube2", "folder", "nexuiz", "zeroad"}},
   };
   EXPECT_EQ(actual, expected);
 }
