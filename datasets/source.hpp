@@ -34,6 +34,9 @@ struct SourceCharacter {
   std::string licence;            ///< SPDX-style, e.g. "CC-BY-SA-3.0"
   std::string attribution;        ///< who made it, for the dataset card
   std::string skeleton;           ///< skeleton family (e.g. "biped", "horse"): grouping, splits
+  /// The up direction of the character's frame; preprocessing rotates it to +Y (normalize.hpp),
+  /// e.g. +Z for the Quake-lineage formats IQM and ZYM.
+  Eigen::Vector3d up = Eigen::Vector3d::UnitY();
   std::vector<Animation> animations;
 };
 

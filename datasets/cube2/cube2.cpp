@@ -89,7 +89,9 @@ std::vector<SourceCharacter> Cube2Builder::read(std::vector<Excluded>& excluded)
     sc.source = "cube2";
     sc.path = path;
     sc.skeleton = rel.has_parent_path() ? rel.begin()->string() : rel.stem().string();
-    iqm.model.name = (rel.parent_path() / rel.stem()).string();
+    iqm.model.name = (rel.parent_path() / rel.stem()).generic_string();
+    std::replace(iqm.model.name.begin(), iqm.model.name.end(), '/', '.');  // an HDF5 name
+    sc.up = Eigen::Vector3d::UnitZ();
     SourceRig rig;
     try {
       rig = to_source_rig(iqm.model);

@@ -12,8 +12,9 @@
 /// - Animations: every clip of every mesh-less `.iqm` in the model's directory whose pose
 ///   hierarchy equals the model's joint hierarchy (same count, same parents). Frames are global
 ///   joint transforms in the model's frame; fps as stored.
-/// - Character name: the path relative to `path` without `.iqm` (e.g. "snoutx10k/snoutx10k");
-///   skeleton family: its first directory ("snoutx10k"); frame and units as in the file (Z up).
+/// - Character name: the path relative to `path` without `.iqm`, '/' replaced by '.' (an HDF5
+///   name; e.g. "snoutx10k.snoutx10k"); skeleton family: its first directory ("snoutx10k");
+///   frame and units as in the file, with SourceCharacter::up = +Z (IQM is Z up).
 /// - Licence and attribution: the Debian copyright file's paragraph for
 ///   `copyright_prefix + <relative path>` (debian_copyright.hpp).
 

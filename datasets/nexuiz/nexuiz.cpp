@@ -79,6 +79,7 @@ std::vector<SourceCharacter> NexuizBuilder::read(std::vector<Excluded>& excluded
       stem.replace_extension();
       std::string character = stem.generic_string();
       if (character.rfind("models/", 0) == 0) character = character.substr(7);
+      std::replace(character.begin(), character.end(), '/', '.');  // an HDF5 name
       zym.model.name = character;
       SourceRig rig = to_source_rig(zym.model);
       SourceCharacter sc;
@@ -87,6 +88,7 @@ std::vector<SourceCharacter> NexuizBuilder::read(std::vector<Excluded>& excluded
       sc.licence = info.licence;
       sc.attribution = info.attribution;
       sc.skeleton = stem.filename().string();
+      sc.up = Eigen::Vector3d::UnitZ();  // Quake units, Z up
       for (const auto& scene : zym.scenes) {
         const std::vector<Transforms> frames(
             zym.poses.begin() + scene.first_pose,

@@ -12,7 +12,8 @@
 ///   per vertex; see zym.hpp), which the shared cleaning reports.
 /// - Animations: one per scene, frames = the scene's poses as global bone transforms; the bind
 ///   pose is pose 0 (as in DarkPlaces).
-/// - Name: the path without "models/" and ".zym" ("player/marine"); skeleton family: the
+/// - Name: the path without "models/" and ".zym", '/' replaced by '.' (an HDF5 name:
+///   "player.marine"); SourceCharacter::up = +Z (Quake frame); skeleton family: the
 ///   character ("marine": every Nexuiz player has its own skeleton, 38–75 bones).
 /// - Licence and attribution from the package's (free-form) copyright file.
 

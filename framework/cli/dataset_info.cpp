@@ -33,10 +33,10 @@ int run_dataset_info(const std::string& file) {
     std::cout << fmt::format(
         "  {}: {} vertices ({} original, {} merged, {} subdivision levels), {} faces, {} joints, "
         "{} bones, "
-        "{} animations; distances: {}; source {} ({}), skeleton {}, licence {}\n",
+        "{} animations; distances: {}; source {} ({}), skeleton {}, group {}, licence {}\n",
         c.name, c.num_vertices(), c.vertex_map.size(), merged(c), c.subdivision_levels, c.F.rows(),
         c.num_joints(), c.num_bones(), c.animations.size(), distances.empty() ? "none" : distances,
-        c.source, c.path, c.skeleton, c.licence.empty() ? "unknown" : c.licence);
+        c.source, c.path, c.skeleton, c.group, c.licence.empty() ? "unknown" : c.licence);
   }
   std::cout << fmt::format("splits: {}\n", d.splits.size());
   for (const auto& [name, s] : d.splits) {

@@ -73,6 +73,9 @@ struct PreparedCharacter {
   std::vector<double> laplacian_values;  ///< #N
   // Provenance (SourceCharacter).
   std::string source, path, licence, attribution, skeleton;
+  /// Variant group (clean.hpp): splits never divide a group. Empty means the character alone
+  /// (written as its own name).
+  std::string group;
   std::vector<AnimationData> animations;
 
   int num_vertices() const { return static_cast<int>(V.rows()); }

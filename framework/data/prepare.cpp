@@ -88,6 +88,8 @@ PrepareConfig PrepareConfig::from(const config::Config& config) {
   PrepareConfig c;
   config::Fields f(config.root(), "dataset config", {});
   c.sources = plugin_list(f.section("sources"), "dataset", false);
+  c.cleaning = CleaningOptions::from(f.section("cleaning"));
+  c.splits = SplitOptions::from(f.section("splits"));
   const config::Node preprocess = f.section("preprocess");
   c.preprocess = PreprocessOptions::from(preprocess);
   const config::Node distances = f.section("distances");
@@ -109,21 +111,27 @@ PrepareReport prepare_dataset(const PrepareConfig& config, const PrepareOptions&
   PrepareReport report;
   report.output = config.output;
 
-  std::vector<datasets::SourceCharacter> characters;
+  std::vector<datasets::SourceCharacter> read_all;
   for (const auto& node : config.sources) {
     const auto builder = dataset_registry().create(node);
     auto read = builder->read(report.excluded);
     spdlog::info("source {}: {} characters", node.required_type("dataset"), read.size());
-    for (auto& c : read) characters.push_back(std::move(c));
+    for (auto& c : read) read_all.push_back(std::move(c));
   }
   {
     std::set<std::string> names;
-    for (const auto& c : characters) {
+    for (const auto& c : read_all) {
       if (!names.insert(c.character.name).second) {
         throw Error("two sources give a character named '" + c.character.name +
                     "' (the second from " + c.source + ": " + c.path + ")");
       }
     }
+  }
+  std::vector<datasets::SourceCharacter> characters;
+  std::vector<std::string> groups;
+  for (auto& c : clean(std::move(read_all), config.cleaning, report.excluded)) {
+    characters.push_back(std::move(c.source));
+    groups.push_back(std::move(c.group));
   }
   const std::vector<NamedDistance> distances = make_distances(config.distances);
 
@@ -176,7 +184,20 @@ PrepareReport prepare_dataset(const PrepareConfig& config, const PrepareOptions&
     }
     Dataset one = read_dataset(partial / (characters[i].character.name + ".h5"));
     dataset.characters.push_back(std::move(one.characters.at(0)));
+    dataset.characters.back().group = groups[i];
     (reused[i] ? report.reused : report.computed) += 1;
+  }
+  {
+    std::vector<std::string> group, skeleton;
+    for (const auto& c : dataset.characters) {
+      group.push_back(c.group);
+      skeleton.push_back(c.skeleton);
+    }
+    dataset.splits = make_splits(group, skeleton, config.splits);
+    for (const auto& [name, split] : dataset.splits) {
+      spdlog::info("split {}: {} train, {} val, {} test", name, split.train.size(),
+                   split.val.size(), split.test.size());
+    }
   }
   write_dataset(config.output, dataset);
   report.characters = dataset.characters.size();

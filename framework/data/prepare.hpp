@@ -7,10 +7,15 @@
 ///
 ///     sources:            # dataset registry nodes, read in order
 ///       - {type: folder, path: ..., licence: ..., attribution: ..., skeleton: ...}
+///     cleaning: {...}     # CleaningOptions (clean.hpp; all optional)
 ///     preprocess: {...}   # PreprocessOptions (all optional)
 ///     distances:          # distance registry nodes; each type at most once
 ///       - {type: hollow_dist, resolution: 88}
+///     splits: {...}       # SplitOptions (splits.hpp; all optional)
 ///     output: results/datasets/name.h5
+///
+/// Order: builders → cleaning (drops and variant groups) → preprocessing of each kept
+/// character → splits over the characters that preprocessed successfully → one file.
 ///
 /// Resumability. Each character is preprocessed into `<output>.partial/<name>.h5` (a dataset file
 /// holding that one character), written through a temporary file and renamed into place, so a
@@ -28,13 +33,17 @@
 
 #include "datasets/source.hpp"
 #include "framework/core/config.hpp"
+#include "framework/data/clean.hpp"
 #include "framework/data/preprocess.hpp"
+#include "framework/data/splits.hpp"
 
 namespace skinlab::data {
 
 struct PrepareConfig {
   std::vector<config::Node> sources;  ///< dataset registry nodes
+  CleaningOptions cleaning;
   PreprocessOptions preprocess;
+  SplitOptions splits;
   std::vector<config::Node> distances;  ///< distance registry nodes
   std::filesystem::path output;
   /// The resolved `preprocess:` and `distances:` sections as YAML (Dataset::preparation).

@@ -122,7 +122,9 @@ PreparedCharacter preprocess(const datasets::SourceCharacter& source,
   if (!c.has_weights()) throw Error(where + ": character has no skin weights");
 
   // 1. Normalise.
-  const geometry::Similarity sim = geometry::normalize(c);
+  geometry::NormalizeOptions normalize_options;
+  normalize_options.source_up = source.up;
+  const geometry::Similarity sim = geometry::normalize(c, normalize_options);
 
   // 2. Merge co-located vertices; average their weights.
   const geometry::MergedMesh merged = geometry::merge_vertices(c.mesh, {options.merge_tolerance});

@@ -139,7 +139,8 @@ TEST(Cli, PrepareAndDatasetInfoOnTheMinetestConfig) {
   for (const std::string part :
        {"format_version 1", "characters: 1", "character: ", "168 original", "6 joints, 10 bones",
         "distances: euclidean (K=3), hollow_dist (K=3)", "skeleton minetest_player",
-        "licence CC-BY-SA-3.0", "splits: 0", "excluded: 0"}) {
+        "group character", "licence CC-BY-SA-3.0", "splits: 1", "random: train 1, val 0, test 0",
+        "excluded: 0"}) {
     EXPECT_NE(info.out.find(part), std::string::npos) << part << "\n" << info.out;
   }
 

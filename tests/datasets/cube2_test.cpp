@@ -76,7 +76,8 @@ TEST(Cube2, BuilderReadsBundledCharacter) {
   EXPECT_EQ(sc.licence, "CC-BY-3.0");
   EXPECT_NE(sc.attribution.find("geartrooper"), std::string::npos) << sc.attribution;
   geometry::Character c = sc.character;
-  EXPECT_EQ(c.name, "snoutx10k/snoutx10k");
+  EXPECT_EQ(c.name, "snoutx10k.snoutx10k");
+  EXPECT_EQ(sc.up, Eigen::Vector3d::UnitZ());
   EXPECT_NO_THROW(c.validate());
   // The two unweighted IK roots ElbowRot.L/.R are pruned; the tree under Root stays whole.
   EXPECT_EQ(c.skeleton.num_joints(), 73);

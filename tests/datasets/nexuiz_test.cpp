@@ -108,7 +108,8 @@ TEST(Nexuiz, BuilderReadsBundledDirectory) {
   EXPECT_EQ(sc.licence, "GPL-2.0-or-later");
   EXPECT_NE(sc.attribution.find("Alientrap"), std::string::npos) << sc.attribution;
   geometry::Character c = sc.character;
-  EXPECT_EQ(c.name, "player/marine");
+  EXPECT_EQ(c.name, "player.marine");
+  EXPECT_EQ(sc.up, Eigen::Vector3d::UnitZ());
   EXPECT_NO_THROW(c.validate());
   EXPECT_EQ(c.mesh.num_vertices(), 2168);
   // Unweighted extra roots (4 roots in the file) are pruned to one tree.
@@ -195,7 +196,7 @@ TEST(Pk3, ReadsDeflatedAndStoredMembersAndFeedsTheBuilder) {
   std::vector<Excluded> excluded;
   const auto characters = NexuizBuilder(bundled_options(file.string())).read(excluded);
   ASSERT_EQ(characters.size(), 1u);
-  EXPECT_EQ(characters[0].character.name, "player/marine");
+  EXPECT_EQ(characters[0].character.name, "player.marine");
   ASSERT_EQ(excluded.size(), 2u);
   EXPECT_EQ(excluded[0].path, "models/player/broken.zym");
   EXPECT_NE(excluded[0].reason.find("data.pk3:models/player/broken.zym"), std::string::npos)

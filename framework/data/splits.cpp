@@ -1,0 +1,123 @@
+#include "framework/data/splits.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <set>
+
+#include "framework/core/error.hpp"
+
+namespace skinlab::data {
+
+SplitOptions SplitOptions::from(const config::Node& node) {
+  SplitOptions o;
+  config::Fields f(node, "splits", {});
+  std::int64_t seed = 0;
+  f.optional("seed", seed);
+  f.check(seed >= 0, "seed", "must be ≥ 0");
+  o.seed = static_cast<std::uint64_t>(seed);
+  std::vector<double> fractions(o.fractions.begin(), o.fractions.end());
+  f.optional("fractions", fractions);
+  f.check(fractions.size() == 3, "fractions", "must be a list of 3 numbers: [train, val, test]");
+  double sum = 0;
+  for (double x : fractions) {
+    f.check(x >= 0 && std::isfinite(x), "fractions", "must be finite and ≥ 0");
+    sum += x;
+  }
+  f.check(std::abs(sum - 1) < 1e-6, "fractions", "must sum to 1");
+  std::copy(fractions.begin(), fractions.end(), o.fractions.begin());
+  f.optional("heldout_skeletons", o.heldout_skeletons);
+  f.finish();
+  return o;
+}
+
+namespace {
+
+/// Uniform integer in [0, n) from the raw engine output (rejection sampling), independent of
+/// the standard library's distribution implementation.
+std::uint64_t draw(std::mt19937_64& rng, std::uint64_t n) {
+  const std::uint64_t limit = std::numeric_limits<std::uint64_t>::max() -
+                              std::numeric_limits<std::uint64_t>::max() % n;
+  std::uint64_t x;
+  do {
+    x = rng();
+  } while (x >= limit);
+  return x % n;
+}
+
+/// Assigns the characters `members` (indices) to train/val/test by whole groups.
+Split split_by_group(const std::vector<int>& members, const std::vector<std::string>& groups,
+                     std::array<double, 3> fractions, std::mt19937_64& rng) {
+  std::vector<std::string> order;
+  std::map<std::string, std::vector<int>> by_group;
+  for (int i : members) {
+    auto& list = by_group[groups[static_cast<std::size_t>(i)]];
+    if (list.empty()) order.push_back(groups[static_cast<std::size_t>(i)]);
+    list.push_back(i);
+  }
+  for (std::size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[draw(rng, i)]);
+  Split split;
+  std::array<std::vector<int>*, 3> parts{&split.train, &split.val, &split.test};
+  const double total = static_cast<double>(members.size());
+  for (const auto& group : order) {
+    int best = 0;
+    double best_deficit = -1e300;
+    for (int s = 0; s < 3; ++s) {
+      if (fractions[static_cast<std::size_t>(s)] <= 0) continue;
+      const double deficit = fractions[static_cast<std::size_t>(s)] * total -
+                             static_cast<double>(parts[static_cast<std::size_t>(s)]->size());
+      if (deficit > best_deficit) best = s, best_deficit = deficit;
+    }
+    for (int i : by_group[group]) parts[static_cast<std::size_t>(best)]->push_back(i);
+  }
+  for (auto* p : parts) std::sort(p->begin(), p->end());
+  return split;
+}
+
+}  // namespace
+
+std::map<std::string, Split> make_splits(const std::vector<std::string>& groups,
+                                         const std::vector<std::string>& skeletons,
+                                         const SplitOptions& options) {
+  if (groups.size() != skeletons.size()) {
+    throw Error("make_splits: " + std::to_string(groups.size()) + " groups but " +
+                std::to_string(skeletons.size()) + " skeleton families");
+  }
+  std::map<std::string, Split> out;
+  const int n = static_cast<int>(groups.size());
+  std::vector<int> all(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) all[static_cast<std::size_t>(i)] = i;
+  std::mt19937_64 rng(options.seed);
+  out["random"] = split_by_group(all, groups, options.fractions, rng);
+
+  if (!options.heldout_skeletons.empty()) {
+    const std::set<std::string> present(skeletons.begin(), skeletons.end());
+    for (const auto& family : options.heldout_skeletons) {
+      if (!present.count(family)) {
+        std::string list;
+        for (const auto& p : present) list += (list.empty() ? "" : ", ") + p;
+        throw Error("splits.heldout_skeletons: no character has skeleton family '" + family +
+                    "'; families present: " + list);
+      }
+    }
+    const std::set<std::string> held(options.heldout_skeletons.begin(),
+                                     options.heldout_skeletons.end());
+    std::vector<int> rest, test;
+    for (int i = 0; i < n; ++i) {
+      (held.count(skeletons[static_cast<std::size_t>(i)]) ? test : rest).push_back(i);
+    }
+    if (rest.empty()) {
+      throw Error("splits.heldout_skeletons: holding out every family leaves nothing to train on");
+    }
+    const double tv = options.fractions[0] + options.fractions[1];
+    std::array<double, 3> ratio{tv > 0 ? options.fractions[0] / tv : 1.0,
+                                tv > 0 ? options.fractions[1] / tv : 0.0, 0.0};
+    std::mt19937_64 rng2(options.seed + 1);
+    Split split = split_by_group(rest, groups, ratio, rng2);
+    split.test = test;
+    out["heldout_skeleton"] = split;
+  }
+  return out;
+}
+
+}  // namespace skinlab::data

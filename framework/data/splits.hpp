@@ -1,0 +1,45 @@
+#pragma once
+/// \file
+/// Train / validation / test splits of a dataset (issue 5, item 5), written to `/splits/<name>`
+/// of the dataset file (datasets/FORMAT.md) by `skinlab prepare`.
+///
+/// - `random`: variant groups (clean.hpp) are shuffled with the seed and assigned one by one to
+///   the split furthest below its target share of characters (fractions 0.7 / 0.1 / 0.2 by
+///   default; ties go to the earlier split), so no group is ever divided and the shares come as
+///   close to the fractions as the group sizes allow.
+/// - `heldout_skeleton` (only when `heldout_skeletons` is not empty): every character whose
+///   skeleton family is listed goes to test; the others are split into train / val by groups as
+///   above, in the ratio of the train and val fractions. It measures generalisation to skeletons
+///   never seen in training (e.g. no elephant and no bird in training).
+///
+/// The shuffle is our own Fisher–Yates over std::mt19937_64 with an explicit integer draw, so a
+/// seed gives the same splits with every standard library.
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "framework/core/config.hpp"
+#include "framework/data/dataset_file.hpp"
+
+namespace skinlab::data {
+
+struct SplitOptions {
+  std::uint64_t seed = 0;
+  std::array<double, 3> fractions{0.7, 0.1, 0.2};  ///< train, val, test; sum 1
+  std::vector<std::string> heldout_skeletons;      ///< skeleton families only in test
+
+  /// Decodes a `splits:` map (every field optional); errors name the file, line and key.
+  static SplitOptions from(const config::Node& node);
+};
+
+/// Splits characters given their group and skeleton family (parallel lists) as the file
+/// comment says. Throws Error when a held-out family is not among `skeletons` (listing those
+/// present) or when held-out families would leave no character for training.
+std::map<std::string, Split> make_splits(const std::vector<std::string>& groups,
+                                         const std::vector<std::string>& skeletons,
+                                         const SplitOptions& options);
+
+}  // namespace skinlab::data
