@@ -20,5 +20,6 @@ Command add_config(CLI::App& app);
 Command add_distance(CLI::App& app);
 Command add_prepare(CLI::App& app);
 Command add_dataset_info(CLI::App& app);
+Command add_dataset_card(CLI::App& app);
 
 }  // namespace skinlab::cli

@@ -93,7 +93,7 @@ int main(int argc, char** argv) {
   const std::vector<skinlab::cli::Command> commands = {
       skinlab::cli::add_info(app), skinlab::cli::add_config(app),
       skinlab::cli::add_distance(app), skinlab::cli::add_prepare(app),
-      skinlab::cli::add_dataset_info(app)};
+      skinlab::cli::add_dataset_info(app), skinlab::cli::add_dataset_card(app)};
 
   try {
     app.parse(argc, argv);

@@ -1,0 +1,35 @@
+/// \file
+/// `skinlab dataset-card <file.h5> [--out datasets/README.md]`: generates the dataset card
+/// (framework/report/dataset_card.hpp) and its histograms from a dataset file.
+
+#include <iostream>
+
+#include "framework/cli/commands.hpp"
+#include "framework/data/dataset_file.hpp"
+#include "framework/report/dataset_card.hpp"
+
+namespace skinlab::cli {
+
+Command add_dataset_card(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "dataset-card", "generate the dataset card (Markdown + PNG histograms) of a dataset file");
+  struct Args {
+    std::string file;
+    std::string out = "datasets/README.md";
+  };
+  auto args = std::make_shared<Args>();
+  cmd->add_option("file", args->file, "dataset file (.h5)")->required();
+  cmd->add_option("--out", args->out, "card to write; figures go to <its dir>/card/")
+      ->capture_default_str();
+  return {cmd, [args] {
+            const data::Dataset d = data::read_dataset(args->file);
+            report::DatasetCardOptions options;
+            options.command = "skinlab dataset-card " + args->file + " --out " + args->out;
+            report::write_dataset_card(d, args->file, args->out, options);
+            std::cout << "wrote " << args->out << " (" << d.characters.size() << " characters, "
+                      << d.excluded.size() << " excluded)\n";
+            return 0;
+          }};
+}
+
+}  // namespace skinlab::cli

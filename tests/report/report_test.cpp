@@ -1,0 +1,112 @@
+// PNG writer, histogram and dataset card (framework/report/).
+
+#include <gtest/gtest.h>
+#include <zlib.h>
+
+#include <filesystem>
+
+#include "../data/data_fixtures.hpp"
+#include "../test_util.hpp"
+#include "framework/core/atomic_file.hpp"
+#include "framework/report/dataset_card.hpp"
+#include "framework/report/plot.hpp"
+
+namespace skinlab::report {
+namespace {
+
+std::uint32_t u32(const std::string& s, std::size_t at) {
+  std::uint32_t v = 0;
+  for (int i = 0; i < 4; ++i) v = (v << 8) | static_cast<std::uint8_t>(s[at + static_cast<std::size_t>(i)]);
+  return v;
+}
+
+TEST(Png, ChunksCarryValidCrcsAndTheScanlinesInflateToThePixels) {
+  Image img(5, 3, {10, 20, 30});
+  img.set(4, 2, {255, 0, 0});
+  const std::string png = encode_png(img);
+  ASSERT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  std::size_t at = 8;
+  std::string idat;
+  std::vector<std::string> types;
+  while (at < png.size()) {
+    const std::uint32_t len = u32(png, at);
+    const std::string type = png.substr(at + 4, 4);
+    const std::string body = png.substr(at + 4, 4 + len);
+    EXPECT_EQ(u32(png, at + 8 + len),
+              crc32(0, reinterpret_cast<const Bytef*>(body.data()), static_cast<uInt>(body.size())))
+        << type;
+    if (type == "IHDR") {
+      EXPECT_EQ(u32(png, at + 8), 5u);
+      EXPECT_EQ(u32(png, at + 12), 3u);
+    }
+    if (type == "IDAT") idat += png.substr(at + 8, len);
+    types.push_back(type);
+    at += 12 + len;
+  }
+  EXPECT_EQ(types, (std::vector<std::string>{"IHDR", "IDAT", "IEND"}));
+  std::string raw(3 * (1 + 5 * 3), '\0');
+  uLongf size = static_cast<uLongf>(raw.size());
+  ASSERT_EQ(uncompress(reinterpret_cast<Bytef*>(raw.data()), &size,
+                       reinterpret_cast<const Bytef*>(idat.data()), static_cast<uLong>(idat.size())),
+            Z_OK);
+  ASSERT_EQ(size, raw.size());
+  EXPECT_EQ(raw[0], '\0');                                          // filter byte
+  EXPECT_EQ(static_cast<std::uint8_t>(raw[1]), 10);                 // first pixel
+  EXPECT_EQ(static_cast<std::uint8_t>(raw[2 * 16 + 1 + 4 * 3]), 255);  // the red pixel
+}
+
+TEST(Histogram, BarHeightsFollowTheCounts) {
+  HistogramOptions o;
+  o.bin_width = 10;
+  // Bins [0,10): 1 value, [10,20): 3 values, [20,30): 2 values.
+  const Image img = histogram({1, 11, 12, 19, 25, 29}, o);
+  auto bar_top = [&](int x) {
+    for (int y = 0; y < img.height; ++y) {
+      const auto* p = &img.pixels[(static_cast<std::size_t>(y) * img.width + x) * 3];
+      if (p[0] == o.bar[0] && p[1] == o.bar[1] && p[2] == o.bar[2]) return y;
+    }
+    return img.height;
+  };
+  // Bars are a third of the plot wide each; sample the middle of each.
+  const int left = 12 + Image::text_width("3", 2), right = img.width - 12;
+  const double w = (right - left) / 3.0;
+  const int h1 = bar_top(left + static_cast<int>(0.5 * w));
+  const int h2 = bar_top(left + static_cast<int>(1.5 * w));
+  const int h3 = bar_top(left + static_cast<int>(2.5 * w));
+  EXPECT_LT(h2, h3);
+  EXPECT_LT(h3, h1);
+  EXPECT_THROW(histogram({}), std::invalid_argument);
+  Image text(20, 10);
+  EXPECT_THROW(text.text(0, 0, "x", 1, {0, 0, 0}), std::invalid_argument);
+}
+
+TEST(DatasetCard, ReportsCountsSplitsExclusionsAndLicences) {
+  data::Dataset d;
+  d.characters = {testing::tiny_character("a"), testing::tiny_character("b"),
+                  testing::tiny_character("c")};
+  d.characters[1].group = "a";
+  d.characters[2].source = "other";
+  d.characters[2].skeleton = "bird";
+  d.characters[2].licence = "GPL-2+";
+  d.splits["random"] = {{0, 1}, {}, {2}};
+  d.excluded = {{"test", "dir/x.fbx", "x: rigid-only weights | one joint"}};
+  testing::TempDir dir;
+  DatasetCardOptions options;
+  options.command = "skinlab dataset-card d.h5";
+  write_dataset_card(d, "results/d.h5", dir / "README.md", options);
+  const std::string md = read_file(dir / "README.md");
+  for (const std::string part :
+       {"# Dataset card: d", "`skinlab dataset-card d.h5`", "| other | 1 | 1 | 1 | 0 |",
+        "| test | 2 | 1 | 1 | 1 |", "| **all** | **3** | **2** | **2** | **1** |",
+        "| random | 0 / 0 / 1 | 2 / 0 / 0 | 2 / 0 / 1 |" /* other, test, all: train/val/test */,
+        "rigid-only weights \\| one joint", "| other | GPL-2+ | 1 | skinlab tests |",
+        "| 2 | c | other | bird | c | 5 → 4 |", "![", "card/bones.png"}) {
+    EXPECT_NE(md.find(part), std::string::npos) << part << "\n" << md;
+  }
+  for (const char* png : {"vertices.png", "source_vertices.png", "joints.png", "bones.png"}) {
+    EXPECT_TRUE(std::filesystem::exists(dir / "card" / png)) << png;
+  }
+}
+
+}  // namespace
+}  // namespace skinlab::report
