@@ -88,7 +88,8 @@ std::vector<std::uint64_t> occupied_cells(const geometry::Mesh& mesh, double cel
     std::uint64_t key = 0;
     for (int a = 0; a < 3; ++a) {
       const auto i = static_cast<std::int64_t>(std::floor(p[a] / cell)) + (1 << 20);
-      key = (key << 21) | (static_cast<std::uint64_t>(std::clamp<std::int64_t>(i, 0, (1 << 21) - 1)));
+      key =
+          (key << 21) | (static_cast<std::uint64_t>(std::clamp<std::int64_t>(i, 0, (1 << 21) - 1)));
     }
     cells.insert(key);
   };
@@ -124,9 +125,10 @@ double overlap(const std::vector<std::uint64_t>& a, const std::vector<std::uint6
           for (int dx = -1; dx <= 1 && !found; ++dx) {
             // Packed x|y|z with 21 bits each and coordinates offset by 2^20: adding a signed
             // offset per field cannot carry across fields for cells inside the range.
-            const std::uint64_t k = key + static_cast<std::uint64_t>(static_cast<std::int64_t>(dx) << 42) +
-                                    static_cast<std::uint64_t>(static_cast<std::int64_t>(dy) << 21) +
-                                    static_cast<std::uint64_t>(static_cast<std::int64_t>(dz));
+            const std::uint64_t k =
+                key + static_cast<std::uint64_t>(static_cast<std::int64_t>(dx) << 42) +
+                static_cast<std::uint64_t>(static_cast<std::int64_t>(dy) << 21) +
+                static_cast<std::uint64_t>(static_cast<std::int64_t>(dz));
             found = std::binary_search(to.begin(), to.end(), k);
           }
         }
@@ -146,7 +148,8 @@ std::string skeleton_key(const datasets::SourceCharacter& c) {
 
 int find(std::vector<int>& parent, int i) {
   while (parent[static_cast<std::size_t>(i)] != i) {
-    parent[static_cast<std::size_t>(i)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
+    parent[static_cast<std::size_t>(i)] =
+        parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
     i = parent[static_cast<std::size_t>(i)];
   }
   return i;
@@ -182,17 +185,18 @@ std::uint64_t geometry_hash(const geometry::Character& character, double quantum
   return h;
 }
 
-double surface_similarity(const geometry::Character& a, const geometry::Character& b,
-                          double cell) {
-  return overlap(occupied_cells(normalised(a).mesh, cell), occupied_cells(normalised(b).mesh, cell));
+double surface_similarity(const geometry::Character& a, const geometry::Character& b, double cell) {
+  return overlap(occupied_cells(normalised(a).mesh, cell),
+                 occupied_cells(normalised(b).mesh, cell));
 }
 
 std::vector<CleanedCharacter> clean(std::vector<datasets::SourceCharacter> characters,
                                     const CleaningOptions& options,
                                     std::vector<datasets::Excluded>& excluded) {
   for (const auto& [name, reason] : options.exclude) {
-    if (std::none_of(characters.begin(), characters.end(),
-                     [&](const datasets::SourceCharacter& c) { return c.character.name == name; })) {
+    if (std::none_of(characters.begin(), characters.end(), [&](const datasets::SourceCharacter& c) {
+          return c.character.name == name;
+        })) {
       throw Error("cleaning.exclude: no source gives a character named '" + name + "'");
     }
   }
@@ -213,8 +217,8 @@ std::vector<CleanedCharacter> clean(std::vector<datasets::SourceCharacter> chara
     }
     const WeightUse use = weight_use(c.character.weights);
     if (use.joints < options.min_bones) {
-      drop("weights use " + std::to_string(use.joints) + " joint(s), fewer than min_bones = " +
-           std::to_string(options.min_bones));
+      drop("weights use " + std::to_string(use.joints) +
+           " joint(s), fewer than min_bones = " + std::to_string(options.min_bones));
       continue;
     }
     if (options.drop_rigid && use.rigid) {
@@ -235,7 +239,8 @@ std::vector<CleanedCharacter> clean(std::vector<datasets::SourceCharacter> chara
   std::iota(parent.begin(), parent.end(), 0);
   if (options.group_similarity <= 1) {
     std::map<std::string, std::vector<int>> by_skeleton;
-    for (int i = 0; i < n; ++i) by_skeleton[skeleton_key(kept[static_cast<std::size_t>(i)])].push_back(i);
+    for (int i = 0; i < n; ++i)
+      by_skeleton[skeleton_key(kept[static_cast<std::size_t>(i)])].push_back(i);
     for (const auto& [key, members] : by_skeleton) {
       std::vector<std::vector<std::uint64_t>> cells;
       for (int i : members) {
@@ -257,7 +262,9 @@ std::vector<CleanedCharacter> clean(std::vector<datasets::SourceCharacter> chara
     }
   }
   std::vector<std::string> group(static_cast<std::size_t>(n));
-  for (int i = 0; i < n; ++i) group[static_cast<std::size_t>(i)] = kept[static_cast<std::size_t>(find(parent, i))].character.name;
+  for (int i = 0; i < n; ++i)
+    group[static_cast<std::size_t>(i)] =
+        kept[static_cast<std::size_t>(find(parent, i))].character.name;
   std::vector<CleanedCharacter> out;
   for (int i = 0; i < n; ++i) {
     CleanedCharacter c;

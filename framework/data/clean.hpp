@@ -76,7 +76,6 @@ std::vector<CleanedCharacter> clean(std::vector<datasets::SourceCharacter> chara
 std::uint64_t geometry_hash(const geometry::Character& character, double quantum);
 
 /// Overlap of the two normalised surfaces on a grid of `cell` metres, in [0, 1] (rule 4).
-double surface_similarity(const geometry::Character& a, const geometry::Character& b,
-                          double cell);
+double surface_similarity(const geometry::Character& a, const geometry::Character& b, double cell);
 
 }  // namespace skinlab::data

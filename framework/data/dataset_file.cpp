@@ -259,7 +259,7 @@ PreparedCharacter read_character(const H5Reader& r, const std::string& name) {
 
 }  // namespace
 
-void write_dataset(const std::filesystem::path& file, const Dataset& dataset) {
+void write_dataset(const std::filesystem::path& file, const Dataset& dataset, int deflate_level) {
   std::set<std::string> names;
   std::vector<std::string> name_list;
   for (const auto& c : dataset.characters) {
@@ -281,7 +281,7 @@ void write_dataset(const std::filesystem::path& file, const Dataset& dataset) {
       }
     }
   }
-  H5Writer w(file);
+  H5Writer w(file, deflate_level);
   w.write_attribute("/", "format_version", kFormatVersion);
   w.write_attribute("/", "skinlab_git_commit", dataset.git_commit);
   w.write_attribute("/", "preparation", dataset.preparation);

@@ -100,7 +100,9 @@ struct Dataset {
 
 /// Writes `dataset` to `file` atomically. Throws IoError for an invalid character name or a
 /// duplicate name, and on any HDF5 failure (naming the file and the dataset).
-void write_dataset(const std::filesystem::path& file, const Dataset& dataset);
+/// `deflate_level` as H5Writer (0: uncompressed, for intermediate files).
+void write_dataset(const std::filesystem::path& file, const Dataset& dataset,
+                   int deflate_level = kDeflateLevel);
 
 /// Reads and validates a dataset file. Throws IoError naming the file and the HDF5 path for: a
 /// missing file, a file that is not HDF5 or is truncated, a missing `format_version` (a foreign

@@ -50,25 +50,26 @@ std::size_t product(const std::vector<hsize_t>& dims) {
 
 /// Chunked + deflate above kChunkThreshold: chunks span whole trailing dimensions and about
 /// 64 Ki elements of the first, so a reader of one row (one vertex) decompresses little.
-H5::DSetCreatPropList creation_properties(const std::vector<hsize_t>& dims) {
+H5::DSetCreatPropList creation_properties(const std::vector<hsize_t>& dims, int level) {
   H5::DSetCreatPropList props;
-  if (dims.empty() || product(dims) < kChunkThreshold) return props;
+  if (level == 0 || dims.empty() || product(dims) < kChunkThreshold) return props;
   std::vector<hsize_t> chunk = dims;
   const std::size_t rest = product(dims) / static_cast<std::size_t>(dims[0]);
   chunk[0] =
       std::max<hsize_t>(1, std::min<hsize_t>(dims[0], 65536 / std::max<std::size_t>(1, rest)));
   props.setChunk(static_cast<int>(chunk.size()), chunk.data());
-  props.setDeflate(kDeflateLevel);
+  props.setDeflate(static_cast<unsigned>(level));
   return props;
 }
 
 template <class T>
 void write_array(H5::H5File& file, const std::filesystem::path& path, const std::string& name,
-                 const std::vector<hsize_t>& dims, const T* data, const H5::PredType& type) {
+                 const std::vector<hsize_t>& dims, const T* data, const H5::PredType& type,
+                 int level) {
   try {
     ensure_groups(file, name, false);
     H5::DataSpace space(static_cast<int>(dims.size()), dims.data());
-    H5::DataSet set = file.createDataSet(name, type, space, creation_properties(dims));
+    H5::DataSet set = file.createDataSet(name, type, space, creation_properties(dims, level));
     if (product(dims) > 0) set.write(data, type);
   } catch (const H5::Exception& e) {
     rethrow(path, "cannot write dataset '" + name + "'", e);
@@ -77,9 +78,9 @@ void write_array(H5::H5File& file, const std::filesystem::path& path, const std:
 
 template <class Matrix>
 void write_matrix(H5::H5File& file, const std::filesystem::path& path, const std::string& name,
-                  const Matrix& m, const H5::PredType& type) {
+                  const Matrix& m, const H5::PredType& type, int level) {
   write_array(file, path, name, {static_cast<hsize_t>(m.rows()), static_cast<hsize_t>(m.cols())},
-              m.data(), type);
+              m.data(), type, level);
 }
 
 H5::DataSet open_dataset(H5::H5File& file, const std::filesystem::path& path,
@@ -146,7 +147,12 @@ H5::Group open_or_create_group(H5::H5File& file, const std::string& object) {
 
 }  // namespace
 
-H5Writer::H5Writer(const std::filesystem::path& target) : out_(target) {
+H5Writer::H5Writer(const std::filesystem::path& target, int deflate_level)
+    : out_(target), deflate_level_(deflate_level) {
+  if (deflate_level < 0 || deflate_level > 9) {
+    throw IoError(target.string() + ": deflate level must be 0..9, got " +
+                  std::to_string(deflate_level));
+  }
   H5::Exception::dontPrint();
   try {
     file_ = std::make_unique<H5::H5File>(out_.temp().string(), H5F_ACC_TRUNC);
@@ -158,27 +164,30 @@ H5Writer::H5Writer(const std::filesystem::path& target) : out_(target) {
 H5Writer::~H5Writer() = default;
 
 void H5Writer::write(const std::string& name, const RowMatrixXd& m) {
-  write_matrix(*file_, out_.target(), name, m, H5::PredType::NATIVE_DOUBLE);
+  write_matrix(*file_, out_.target(), name, m, H5::PredType::NATIVE_DOUBLE, deflate_level_);
 }
 void H5Writer::write(const std::string& name, const RowMatrixXf& m) {
-  write_matrix(*file_, out_.target(), name, m, H5::PredType::NATIVE_FLOAT);
+  write_matrix(*file_, out_.target(), name, m, H5::PredType::NATIVE_FLOAT, deflate_level_);
 }
 void H5Writer::write(const std::string& name, const RowMatrixXi& m) {
-  write_matrix(*file_, out_.target(), name, m, H5::PredType::NATIVE_INT);
+  write_matrix(*file_, out_.target(), name, m, H5::PredType::NATIVE_INT, deflate_level_);
 }
 void H5Writer::write(const std::string& name, const std::vector<int>& v) {
-  write_array(*file_, out_.target(), name, {v.size()}, v.data(), H5::PredType::NATIVE_INT);
+  write_array(*file_, out_.target(), name, {v.size()}, v.data(), H5::PredType::NATIVE_INT,
+              deflate_level_);
 }
 void H5Writer::write(const std::string& name, const std::vector<float>& v) {
-  write_array(*file_, out_.target(), name, {v.size()}, v.data(), H5::PredType::NATIVE_FLOAT);
+  write_array(*file_, out_.target(), name, {v.size()}, v.data(), H5::PredType::NATIVE_FLOAT,
+              deflate_level_);
 }
 void H5Writer::write(const std::string& name, const std::vector<double>& v) {
-  write_array(*file_, out_.target(), name, {v.size()}, v.data(), H5::PredType::NATIVE_DOUBLE);
+  write_array(*file_, out_.target(), name, {v.size()}, v.data(), H5::PredType::NATIVE_DOUBLE,
+              deflate_level_);
 }
 void H5Writer::write(const std::string& name, const std::vector<std::size_t>& dims,
                      const float* data) {
   write_array(*file_, out_.target(), name, std::vector<hsize_t>(dims.begin(), dims.end()), data,
-              H5::PredType::NATIVE_FLOAT);
+              H5::PredType::NATIVE_FLOAT, deflate_level_);
 }
 
 void H5Writer::write_strings(const std::string& name, const std::vector<std::string>& values) {

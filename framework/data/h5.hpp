@@ -2,7 +2,8 @@
 /// \file
 /// Small HDF5 layer over the C++ API: Eigen matrices as 2-D datasets (row-major on disk, so
 /// `h5dump` and h5py show them as they print), 1-D arrays, N-D float arrays, variable-length
-/// string lists, and (variable-length) string, integer and number attributes on any group. Groups are created by
+/// string lists, and (variable-length) string, integer and number attributes on any group. Groups
+/// are created by
 /// '/' in the name. Arrays of at least kChunkThreshold elements are chunked and
 /// deflate-compressed (gzip level 4, which h5py and h5dump read without plug-ins).
 ///
@@ -38,8 +39,10 @@ inline constexpr int kDeflateLevel = 4;
 
 class H5Writer {
  public:
-  /// Starts writing `target` (through a temporary file in the same directory).
-  explicit H5Writer(const std::filesystem::path& target);
+  /// Starts writing `target` (through a temporary file in the same directory). Arrays of at
+  /// least kChunkThreshold elements are chunked and deflated at `deflate_level` (1–9); 0 stores
+  /// everything contiguous and uncompressed (fast, for intermediate files).
+  explicit H5Writer(const std::filesystem::path& target, int deflate_level = kDeflateLevel);
   ~H5Writer();
   H5Writer(const H5Writer&) = delete;
   H5Writer& operator=(const H5Writer&) = delete;
@@ -73,6 +76,7 @@ class H5Writer {
 
  private:
   AtomicPath out_;
+  int deflate_level_;
   std::unique_ptr<H5::H5File> file_;
 };
 

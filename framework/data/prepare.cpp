@@ -159,7 +159,7 @@ PrepareReport prepare_dataset(const PrepareConfig& config, const PrepareOptions&
         one.git_commit = commit;
         one.preparation = config.preparation;
         one.characters.push_back(preprocess(source, distances, config.preprocess));
-        write_dataset(file, one);
+        write_dataset(file, one, 0);  // uncompressed: HDF5's global lock would serialise deflate
       }
     } catch (const std::exception& e) {
       const std::string what = e.what();

@@ -36,8 +36,8 @@ namespace {
 /// Uniform integer in [0, n) from the raw engine output (rejection sampling), independent of
 /// the standard library's distribution implementation.
 std::uint64_t draw(std::mt19937_64& rng, std::uint64_t n) {
-  const std::uint64_t limit = std::numeric_limits<std::uint64_t>::max() -
-                              std::numeric_limits<std::uint64_t>::max() % n;
+  const std::uint64_t limit =
+      std::numeric_limits<std::uint64_t>::max() - std::numeric_limits<std::uint64_t>::max() % n;
   std::uint64_t x;
   do {
     x = rng();

@@ -30,27 +30,36 @@ const std::array<const char*, 5>* glyph(char c) {
   static const std::array<const char*, 5> space = {"...", "...", "...", "...", "..."};
   if (c >= '0' && c <= '9') return &digits[c - '0'];
   switch (c) {
-    case '.': return &dot;
-    case '-': return &minus;
-    case '+': return &plus;
-    case 'k': return &k;
-    case 'M': return &m;
-    case '%': return &percent;
-    case ' ': return &space;
-    default: return nullptr;
+    case '.':
+      return &dot;
+    case '-':
+      return &minus;
+    case '+':
+      return &plus;
+    case 'k':
+      return &k;
+    case 'M':
+      return &m;
+    case '%':
+      return &percent;
+    case ' ':
+      return &space;
+    default:
+      return nullptr;
   }
 }
 
 void put_u32(std::string& out, std::uint32_t v) {
-  for (int shift = 24; shift >= 0; shift -= 8) out.push_back(static_cast<char>((v >> shift) & 0xff));
+  for (int shift = 24; shift >= 0; shift -= 8)
+    out.push_back(static_cast<char>((v >> shift) & 0xff));
 }
 
 void chunk(std::string& out, const char* type, const std::string& data) {
   put_u32(out, static_cast<std::uint32_t>(data.size()));
   const std::string body = std::string(type, 4) + data;
   out += body;
-  put_u32(out, static_cast<std::uint32_t>(
-                   crc32(0, reinterpret_cast<const Bytef*>(body.data()), static_cast<uInt>(body.size()))));
+  put_u32(out, static_cast<std::uint32_t>(crc32(0, reinterpret_cast<const Bytef*>(body.data()),
+                                                static_cast<uInt>(body.size()))));
 }
 
 /// 1, 2 or 5 × 10^k closest above range / bins.
@@ -64,7 +73,8 @@ double nice_width(double range, int bins) {
 }
 
 std::string label(double v) {
-  if (std::abs(v) >= 10000 && std::fmod(v, 1000) == 0) return std::to_string(static_cast<long long>(v / 1000)) + "k";
+  if (std::abs(v) >= 10000 && std::fmod(v, 1000) == 0)
+    return std::to_string(static_cast<long long>(v / 1000)) + "k";
   if (v == std::floor(v)) return std::to_string(static_cast<long long>(v));
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.3g", v);
@@ -77,7 +87,8 @@ Image::Image(int w, int h, Rgb background) : width(w), height(h) {
   if (w <= 0 || h <= 0) throw std::invalid_argument("Image: size must be positive");
   pixels.resize(static_cast<std::size_t>(w) * h * 3);
   for (std::size_t i = 0; i < pixels.size(); i += 3) {
-    std::copy(background.begin(), background.end(), pixels.begin() + static_cast<std::ptrdiff_t>(i));
+    std::copy(background.begin(), background.end(),
+              pixels.begin() + static_cast<std::ptrdiff_t>(i));
   }
 }
 
@@ -152,7 +163,8 @@ Image histogram(const std::vector<double>& values, const HistogramOptions& o) {
   const int bins = std::max(1, static_cast<int>(std::floor((*max_it - lo) / w)) + 1);
   std::vector<int> count(static_cast<std::size_t>(bins), 0);
   for (double v : values) {
-    count[static_cast<std::size_t>(std::clamp(static_cast<int>(std::floor((v - lo) / w)), 0, bins - 1))]++;
+    count[static_cast<std::size_t>(
+        std::clamp(static_cast<int>(std::floor((v - lo) / w)), 0, bins - 1))]++;
   }
   const int top = *std::max_element(count.begin(), count.end());
 
@@ -175,7 +187,8 @@ Image histogram(const std::vector<double>& values, const HistogramOptions& o) {
   for (int b = 0; b < bins; ++b) {
     const int x0 = left + static_cast<int>(std::lround(b * bar_w)) + 1;
     const int x1 = left + static_cast<int>(std::lround((b + 1) * bar_w)) - 1;
-    if (count[static_cast<std::size_t>(b)] > 0) img.fill_rect(x0, y_of(count[static_cast<std::size_t>(b)]), x1, bottom, o.bar);
+    if (count[static_cast<std::size_t>(b)] > 0)
+      img.fill_rect(x0, y_of(count[static_cast<std::size_t>(b)]), x1, bottom, o.bar);
   }
   img.fill_rect(left, bottom, right, bottom, ink);
   img.fill_rect(left, top_y, left, bottom, ink);

@@ -22,7 +22,7 @@ struct Image {
   std::vector<std::uint8_t> pixels;  ///< row-major RGB, top row first
 
   Image(int w, int h, Rgb background = {255, 255, 255});
-  void set(int x, int y, Rgb c);  ///< ignores pixels outside the image
+  void set(int x, int y, Rgb c);                          ///< ignores pixels outside the image
   void fill_rect(int x0, int y0, int x1, int y1, Rgb c);  ///< inclusive corners, clipped
   /// Draws `text` (digits, '.', '-', '+', 'k', 'M', '%', ' ') with its top-left corner at
   /// (x, y), each font pixel `scale`×`scale`. Other characters throw std::invalid_argument.

@@ -80,9 +80,9 @@ datasets::SourceCharacter reordered_copy(const datasets::SourceCharacter& s,
 
 TEST(Clean, DropsRigidAndFewBoneCharactersWithReasons) {
   std::vector<datasets::Excluded> excluded;
-  auto kept = clean({sheet("blended", 8, 0.0), sheet("rigid", 8, 0.3, true),
-                     sheet("three", 8, 0.6, false, 3)},
-                    CleaningOptions{}, excluded);
+  auto kept = clean(
+      {sheet("blended", 8, 0.0), sheet("rigid", 8, 0.3, true), sheet("three", 8, 0.6, false, 3)},
+      CleaningOptions{}, excluded);
   ASSERT_EQ(kept.size(), 1u);
   EXPECT_EQ(kept[0].source.character.name, "blended");
   ASSERT_EQ(excluded.size(), 2u);
@@ -128,9 +128,9 @@ TEST(Clean, GroupsNearIdenticalMeshesOnTheSameSkeletonOnly) {
   auto other_family = sheet("other_family", 8, 0.02);
   other_family.skeleton = "other";
   std::vector<datasets::Excluded> excluded;
-  auto kept = clean({sheet("base", 8, 0.0), sheet("variant", 8, 0.01), sheet("bent", 8, 1.0),
-                     other_family},
-                    CleaningOptions{}, excluded);
+  auto kept =
+      clean({sheet("base", 8, 0.0), sheet("variant", 8, 0.01), sheet("bent", 8, 1.0), other_family},
+            CleaningOptions{}, excluded);
   ASSERT_EQ(kept.size(), 4u);
   std::map<std::string, std::string> group;
   for (const auto& k : kept) group[k.source.character.name] = k.group;
@@ -210,8 +210,7 @@ TEST(Splits, OptionsAreValidated) {
   EXPECT_THROW(parse("fractions: [0.5, 0.1, 0.1]"), ConfigError);
   EXPECT_THROW(parse("fractions: [0.9, 0.1]"), ConfigError);
   EXPECT_THROW(parse("heldout: [bird]"), ConfigError);
-  EXPECT_THROW(CleaningOptions::from(config::Config::parse("min_bone: 3").root()),
-               ConfigError);
+  EXPECT_THROW(CleaningOptions::from(config::Config::parse("min_bone: 3").root()), ConfigError);
 }
 
 }  // namespace

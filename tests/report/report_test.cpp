@@ -16,7 +16,8 @@ namespace {
 
 std::uint32_t u32(const std::string& s, std::size_t at) {
   std::uint32_t v = 0;
-  for (int i = 0; i < 4; ++i) v = (v << 8) | static_cast<std::uint8_t>(s[at + static_cast<std::size_t>(i)]);
+  for (int i = 0; i < 4; ++i)
+    v = (v << 8) | static_cast<std::uint8_t>(s[at + static_cast<std::size_t>(i)]);
   return v;
 }
 
@@ -46,12 +47,13 @@ TEST(Png, ChunksCarryValidCrcsAndTheScanlinesInflateToThePixels) {
   EXPECT_EQ(types, (std::vector<std::string>{"IHDR", "IDAT", "IEND"}));
   std::string raw(3 * (1 + 5 * 3), '\0');
   uLongf size = static_cast<uLongf>(raw.size());
-  ASSERT_EQ(uncompress(reinterpret_cast<Bytef*>(raw.data()), &size,
-                       reinterpret_cast<const Bytef*>(idat.data()), static_cast<uLong>(idat.size())),
-            Z_OK);
+  ASSERT_EQ(
+      uncompress(reinterpret_cast<Bytef*>(raw.data()), &size,
+                 reinterpret_cast<const Bytef*>(idat.data()), static_cast<uLong>(idat.size())),
+      Z_OK);
   ASSERT_EQ(size, raw.size());
-  EXPECT_EQ(raw[0], '\0');                                          // filter byte
-  EXPECT_EQ(static_cast<std::uint8_t>(raw[1]), 10);                 // first pixel
+  EXPECT_EQ(raw[0], '\0');                                             // filter byte
+  EXPECT_EQ(static_cast<std::uint8_t>(raw[1]), 10);                    // first pixel
   EXPECT_EQ(static_cast<std::uint8_t>(raw[2 * 16 + 1 + 4 * 3]), 255);  // the red pixel
 }
 
