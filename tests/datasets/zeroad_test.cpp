@@ -1,6 +1,7 @@
 // The 0 A.D. source on the bundled real subset (datasets/zeroad/bundled, CC-BY-SA 3.0,
 // Wildfire Games): PMD/PSA/skeleton parsers, LBS round trips and the `zeroad` builder.
 #include <gtest/gtest.h>
+#include <zip.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -9,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include "../test_util.hpp"
 #include "datasets/zeroad/package.hpp"
 #include "datasets/zeroad/read_actor.hpp"
 #include "datasets/zeroad/read_pmd.hpp"
@@ -29,18 +31,18 @@ const std::string kTunic = "art/meshes/skeletal/new/m_tunic_short.dae.cached.pmd
 
 std::string read_bundled(const std::string& entry) { return Package(kBundled).read(entry); }
 
-testing::AssertionResult throws_with(const std::function<void()>& f,
-                                     const std::vector<std::string>& parts) {
+::testing::AssertionResult throws_with(const std::function<void()>& f,
+                                       const std::vector<std::string>& parts) {
   try {
     f();
   } catch (const Error& e) {
     const std::string msg = e.what();
     for (const auto& p : parts)
       if (msg.find(p) == std::string::npos)
-        return testing::AssertionFailure() << "message '" << msg << "' lacks '" << p << "'";
-    return testing::AssertionSuccess();
+        return ::testing::AssertionFailure() << "message '" << msg << "' lacks '" << p << "'";
+    return ::testing::AssertionSuccess();
   }
-  return testing::AssertionFailure() << "no skinlab::Error thrown";
+  return ::testing::AssertionFailure() << "no skinlab::Error thrown";
 }
 
 /// Builds the bundled dataset once for all tests.
@@ -213,6 +215,39 @@ TEST(ZeroAdPackage, ListsAndReadsDirectoryAndRejectsMissingPath) {
   EXPECT_TRUE(throws_with([&] { pkg.read("art/none.pmd"); }, {"no entry 'art/none.pmd'"}));
   EXPECT_TRUE(
       throws_with([] { Package p("/nonexistent/public.zip"); }, {"/nonexistent/public.zip"}));
+}
+
+/// Packs `entries` of the bundled tree into a zip archive at `file` with libzip (deflated, as
+/// Debian's public.zip is), so the archive path of Package is tested without the 3.2 GB package.
+void write_zip(const std::filesystem::path& file, const std::vector<std::string>& entries,
+               std::vector<std::string>& keep_alive) {
+  int error = 0;
+  zip_t* z = zip_open(file.c_str(), ZIP_CREATE | ZIP_TRUNCATE, &error);
+  ASSERT_NE(z, nullptr) << "zip_open error " << error;
+  for (const auto& e : entries) {
+    keep_alive.push_back(Package(kBundled).read(e));
+    zip_source_t* src = zip_source_buffer(z, keep_alive.back().data(), keep_alive.back().size(), 0);
+    ASSERT_NE(src, nullptr);
+    ASSERT_GE(zip_file_add(z, e.c_str(), src, ZIP_FL_ENC_UTF_8), 0) << zip_strerror(z);
+  }
+  ASSERT_EQ(zip_close(z), 0);
+}
+
+TEST(ZeroAdPackage, ReadsTheZipArchiveLikeTheDirectory) {
+  skinlab::testing::TempDir dir;
+  const Package tree(kBundled);
+  std::vector<std::string> entries = tree.list("art/skeletons/", ".xml");
+  entries.push_back(kTunic);
+  std::vector<std::string> buffers;
+  write_zip(dir / "public.zip", entries, buffers);
+  const Package zip(dir / "public.zip");
+  EXPECT_EQ(zip.list("art/skeletons/", ".xml"), tree.list("art/skeletons/", ".xml"));
+  EXPECT_EQ(zip.list("art/meshes/skeletal/", ".pmd"), std::vector<std::string>{kTunic});
+  for (const auto& e : entries) EXPECT_EQ(zip.read(e), tree.read(e)) << e;
+  EXPECT_TRUE(throws_with([&] { zip.read("art/none.pmd"); }, {"art/none.pmd"}));
+  // A regular file that is not a zip archive is rejected with its path.
+  std::ofstream(dir / "broken.zip") << "not a zip archive";
+  EXPECT_TRUE(throws_with([&] { Package p(dir / "broken.zip"); }, {"broken.zip"}));
 }
 
 const std::set<std::string> kExpectedNames = {
