@@ -1,6 +1,7 @@
 #include "framework/data/clean.hpp"
 
 #include <spdlog/spdlog.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
@@ -241,24 +242,34 @@ std::vector<CleanedCharacter> clean(std::vector<datasets::SourceCharacter> chara
     std::map<std::string, std::vector<int>> by_skeleton;
     for (int i = 0; i < n; ++i)
       by_skeleton[skeleton_key(kept[static_cast<std::size_t>(i)])].push_back(i);
+    // Occupied cells of every character, and the overlap of every same-skeleton pair, in
+    // parallel (TBB, in the caller's arena); the union below is serial and in pair order, so
+    // the groups do not depend on the thread count.
+    std::vector<std::vector<std::uint64_t>> cells(static_cast<std::size_t>(n));
+    tbb::parallel_for(0, n, [&](int i) {
+      cells[static_cast<std::size_t>(i)] = occupied_cells(
+          normalised(kept[static_cast<std::size_t>(i)].character).mesh, options.group_cell);
+    });
+    std::vector<std::pair<int, int>> pairs;
     for (const auto& [key, members] : by_skeleton) {
-      std::vector<std::vector<std::uint64_t>> cells;
-      for (int i : members) {
-        cells.push_back(occupied_cells(normalised(kept[static_cast<std::size_t>(i)].character).mesh,
-                                       options.group_cell));
-      }
       for (std::size_t x = 0; x < members.size(); ++x) {
-        for (std::size_t y = x + 1; y < members.size(); ++y) {
-          const double s = overlap(cells[x], cells[y]);
-          if (s >= options.group_similarity) {
-            spdlog::debug("cleaning: {} ~ {} (similarity {:.3f})",
-                          kept[static_cast<std::size_t>(members[x])].character.name,
-                          kept[static_cast<std::size_t>(members[y])].character.name, s);
-            const int rx = find(parent, members[x]), ry = find(parent, members[y]);
-            parent[static_cast<std::size_t>(std::max(rx, ry))] = std::min(rx, ry);
-          }
-        }
+        for (std::size_t y = x + 1; y < members.size(); ++y)
+          pairs.emplace_back(members[x], members[y]);
       }
+    }
+    std::vector<double> similarity(pairs.size());
+    tbb::parallel_for(std::size_t{0}, pairs.size(), [&](std::size_t k) {
+      similarity[k] = overlap(cells[static_cast<std::size_t>(pairs[k].first)],
+                              cells[static_cast<std::size_t>(pairs[k].second)]);
+    });
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+      if (similarity[k] < options.group_similarity) continue;
+      const auto [a, b] = pairs[k];
+      spdlog::debug("cleaning: {} ~ {} (similarity {:.4f})",
+                    kept[static_cast<std::size_t>(a)].character.name,
+                    kept[static_cast<std::size_t>(b)].character.name, similarity[k]);
+      const int ra = find(parent, a), rb = find(parent, b);
+      parent[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
     }
   }
   std::vector<std::string> group(static_cast<std::size_t>(n));

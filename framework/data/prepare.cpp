@@ -127,9 +127,12 @@ PrepareReport prepare_dataset(const PrepareConfig& config, const PrepareOptions&
       }
     }
   }
+  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   std::vector<datasets::SourceCharacter> characters;
   std::vector<std::string> groups;
-  for (auto& c : clean(std::move(read_all), config.cleaning, report.excluded)) {
+  std::vector<CleanedCharacter> cleaned;
+  arena.execute([&] { cleaned = clean(std::move(read_all), config.cleaning, report.excluded); });
+  for (auto& c : cleaned) {
     characters.push_back(std::move(c.source));
     groups.push_back(std::move(c.group));
   }
@@ -168,7 +171,6 @@ PrepareReport prepare_dataset(const PrepareConfig& config, const PrepareOptions&
     std::lock_guard<std::mutex> lock(mutex);
     if (progress) progress->tick();
   };
-  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   arena.execute([&] { tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) { work(i); }); });
   if (progress) progress->finish();
 
