@@ -10,7 +10,7 @@ namespace {
 
 using namespace skinlab;
 
-const std::string kConfig = std::string(SKINLAB_SOURCE_DIR) + "/configs/ablations/wo_smoothing.yaml";
+const std::string kConfig = std::string(SKINLAB_SOURCE_DIR) + "/configs/ablations/no_smoothing.yaml";
 
 void BM_LoadConfig(benchmark::State& state) {
   for (auto _ : state) {

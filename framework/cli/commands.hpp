@@ -6,6 +6,8 @@
 #include <CLI/CLI.hpp>
 
 #include <functional>
+#include <string>
+#include <vector>
 
 namespace skinlab::cli {
 
@@ -21,5 +23,10 @@ Command add_distance(CLI::App& app);
 Command add_prepare(CLI::App& app);
 Command add_dataset_info(CLI::App& app);
 Command add_dataset_card(CLI::App& app);
+Command add_train(CLI::App& app);
+Command add_eval(CLI::App& app);
+
+/// The command line `skinlab` was started with (recorded in a run's env.json).
+const std::vector<std::string>& command_line();
 
 }  // namespace skinlab::cli

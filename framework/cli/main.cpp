@@ -54,7 +54,14 @@ int run_info(bool as_json) {
   return 0;
 }
 
+std::vector<std::string>& command_line_storage() {
+  static std::vector<std::string> args;
+  return args;
+}
+
 }  // namespace
+
+const std::vector<std::string>& command_line() { return command_line_storage(); }
 
 Command add_info(CLI::App& app) {
   auto* cmd = app.add_subcommand("info", "versions, threads and every registry with its keys");
@@ -81,6 +88,7 @@ Command add_config(CLI::App& app) {
 }  // namespace skinlab::cli
 
 int main(int argc, char** argv) {
+  skinlab::cli::command_line_storage().assign(argv, argv + argc);
   CLI::App app{"skinlab: learned character skinning (HeterSkinNet and baselines)"};
   app.require_subcommand(1);
   std::string log_level = "info";
@@ -93,7 +101,8 @@ int main(int argc, char** argv) {
   const std::vector<skinlab::cli::Command> commands = {
       skinlab::cli::add_info(app), skinlab::cli::add_config(app),
       skinlab::cli::add_distance(app), skinlab::cli::add_prepare(app),
-      skinlab::cli::add_dataset_info(app), skinlab::cli::add_dataset_card(app)};
+      skinlab::cli::add_dataset_info(app), skinlab::cli::add_dataset_card(app),
+      skinlab::cli::add_train(app), skinlab::cli::add_eval(app)};
 
   try {
     app.parse(argc, argv);

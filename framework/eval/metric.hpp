@@ -9,11 +9,16 @@
 ///       - {type: precision_recall, threshold: 1.0e-4, prune: 0.25}
 ///       - {type: avg_l1}
 ///       - {type: deformation_error, poses: 10}
+///
+/// Registered metrics (each documented in its own header, with its thresholds):
+/// precision_recall.hpp, avg_l1.hpp, deformation_error.hpp; evaluate.hpp builds the list and
+/// averages over characters.
 
 #include <torch/torch.h>
 
 #include <map>
 #include <string>
+#include <vector>
 
 #include "framework/data/dataset_file.hpp"
 
@@ -33,6 +38,10 @@ class Metric {
   /// Named values for one character, e.g. {"precision": 0.8, "recall": 0.7}. Names are unique
   /// across the registered metrics so the evaluator can merge them.
   virtual std::map<std::string, double> operator()(const MetricInputs& in) const = 0;
+  /// The names operator() returns, known before any character is evaluated, so a `metrics:`
+  /// list with two metrics reporting the same name is rejected when it is built (evaluate.hpp)
+  /// and a table knows its columns.
+  virtual std::vector<std::string> names() const = 0;
 };
 
 }  // namespace skinlab::eval

@@ -1,5 +1,6 @@
 #include "framework/geometry/lbs.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -51,19 +52,51 @@ std::vector<Eigen::Affine3d> forward_kinematics(const Skeleton& skeleton,
   return T;
 }
 
+namespace {
+
+/// Uniform on the open interval (0, 1) from one 32-bit draw.
+double uniform_open(std::mt19937& rng) {
+  return (static_cast<double>(rng()) + 0.5) * 0x1p-32;
+}
+
+/// Standard normal by Box–Muller (the cosine branch only), from two draws.
+double standard_normal(std::mt19937& rng) {
+  const double u1 = uniform_open(rng), u2 = uniform_open(rng);
+  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
+}
+
+}  // namespace
+
 std::vector<Eigen::Matrix3d> random_pose(const Skeleton& skeleton, std::mt19937& rng,
                                          double fraction, double sigma_degrees) {
-  std::bernoulli_distribution pick(fraction);
-  std::normal_distribution<double> angle(0.0, sigma_degrees * M_PI / 180.0);
-  std::normal_distribution<double> gauss(0.0, 1.0);
-  std::vector<Eigen::Matrix3d> R(skeleton.num_joints(), Eigen::Matrix3d::Identity());
-  for (auto& r : R) {
-    if (!pick(rng)) continue;
+  if (!(fraction >= 0 && fraction <= 1)) {
+    throw GeometryError("random_pose: fraction must be in [0, 1], got " + std::to_string(fraction));
+  }
+  if (!(sigma_degrees >= 0) || !std::isfinite(sigma_degrees)) {
+    throw GeometryError("random_pose: sigma_degrees must be finite and ≥ 0, got " +
+                        std::to_string(sigma_degrees));
+  }
+  const int n = skeleton.num_joints();
+  const int k = static_cast<int>(std::lround(fraction * n));
+  // The first k entries of a partial Fisher–Yates shuffle are a uniform k-subset.
+  std::vector<int> order(n);
+  for (int j = 0; j < n; ++j) order[j] = j;
+  for (int i = 0; i < k; ++i) {
+    const int pick = std::min(n - 1, i + static_cast<int>(uniform_open(rng) * (n - i)));
+    std::swap(order[i], order[pick]);
+  }
+  std::vector<bool> rotated(n, false);
+  for (int i = 0; i < k; ++i) rotated[order[i]] = true;
+
+  const double sigma = sigma_degrees * M_PI / 180.0;
+  std::vector<Eigen::Matrix3d> R(n, Eigen::Matrix3d::Identity());
+  for (int j = 0; j < n; ++j) {  // index order, so the draws do not depend on the shuffle order
+    if (!rotated[j]) continue;
     Eigen::Vector3d axis;
     do {  // a normalised Gaussian vector is uniform on the sphere
-      axis = Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng));
+      axis = Eigen::Vector3d(standard_normal(rng), standard_normal(rng), standard_normal(rng));
     } while (axis.norm() < 1e-9);
-    r = Eigen::AngleAxisd(angle(rng), axis.normalized()).toRotationMatrix();
+    R[j] = Eigen::AngleAxisd(sigma * standard_normal(rng), axis.normalized()).toRotationMatrix();
   }
   return R;
 }

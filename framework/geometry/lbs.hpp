@@ -40,9 +40,20 @@ Eigen::MatrixXd lbs(const Eigen::MatrixXd& V, const SparseWeights& W,
 std::vector<Eigen::Affine3d> forward_kinematics(const Skeleton& skeleton,
                                                 const std::vector<Eigen::Matrix3d>& local_rotations);
 
-/// A random pose for the deformation error metric: each joint is rotated with probability
-/// `fraction` (default 30% of the joints) by an angle drawn from N(0, sigma_degrees²) (default
-/// 25°) about a uniformly random axis; the others keep the identity. Returns #J rotations.
+/// A random pose for the deformation error metric (HeterSkinNet Sec. 4.3: "rotating 30% of bones
+/// ... by angles sampled independently from N(0, 25°)"): round(fraction · #J) distinct joints,
+/// chosen uniformly, are each rotated by an angle drawn from N(0, sigma_degrees²) about a
+/// uniformly random axis; the others keep the identity. A joint's rotation turns every bone that
+/// starts at it, so the paper's fraction of bones is taken as that fraction of the joints, and as
+/// an exact count rather than a per-joint coin flip (which would leave small skeletons unposed
+/// now and then).
+///
+/// Only the raw 32-bit output of `rng` is used (uniforms from single draws, normals by
+/// Box–Muller), not std:: distributions, whose algorithms differ between standard libraries: a
+/// seeded mt19937 gives the same pose with any toolchain.
+///
+/// Returns #J rotation matrices. Throws GeometryError unless 0 ≤ fraction ≤ 1 and
+/// sigma_degrees is finite and ≥ 0.
 std::vector<Eigen::Matrix3d> random_pose(const Skeleton& skeleton, std::mt19937& rng,
                                          double fraction = 0.3, double sigma_degrees = 25.0);
 

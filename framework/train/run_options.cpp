@@ -1,9 +1,45 @@
 #include "framework/train/run_options.hpp"
 
+#include <cmath>
+
 #include "framework/core/registry.hpp"
 #include "framework/losses/loss.hpp"
 
 namespace skinlab::train {
+
+DataOptions DataOptions::from(const config::Node& node) {
+  DataOptions o;
+  config::Fields f(node, "the data section", {});
+  f.required("file", o.file).check(!o.file.empty(), "file", "must not be empty");
+  f.optional("split", o.split).check(!o.split.empty(), "split", "must not be empty");
+  f.optional("distance", o.distance);
+  if (!distance_registry().contains(o.distance)) {
+    node["distance"].fail(distance_registry().unknown_key_message(o.distance));
+  }
+  f.finish();
+  return o;
+}
+
+TrainOptions TrainOptions::from(const config::Node& node) {
+  TrainOptions o;
+  config::Fields f(node, "the train section", {});
+  f.optional("epochs", o.epochs).check(o.epochs >= 1, "epochs", "must be ≥ 1");
+  f.optional("lr", o.lr).check(std::isfinite(o.lr) && o.lr > 0, "lr", "must be a positive number");
+  f.optional("weight_decay", o.weight_decay)
+      .check(std::isfinite(o.weight_decay) && o.weight_decay >= 0, "weight_decay",
+             "must be a number ≥ 0");
+  f.optional("patience", o.patience)
+      .check(o.patience >= 0, "patience", "must be ≥ 0 (0 disables early stopping)");
+  f.optional("min_delta", o.min_delta)
+      .check(std::isfinite(o.min_delta) && o.min_delta >= 0, "min_delta", "must be a number ≥ 0");
+  f.optional("max_characters_per_epoch", o.max_characters_per_epoch)
+      .check(o.max_characters_per_epoch >= 0, "max_characters_per_epoch",
+             "must be ≥ 0 (0 = every training character)");
+  f.optional("log_every", o.log_every)
+      .check(o.log_every >= 0, "log_every", "must be ≥ 0 (0 = one line per epoch)");
+  f.finish();
+  return o;
+}
 
 RunOptions RunOptions::from(const config::Config& config) {
   RunOptions o;
@@ -19,6 +55,8 @@ RunOptions RunOptions::from(const config::Config& config) {
   o.model = f.section("model");
   o.losses = f.section("losses");
   o.metrics = f.section("metrics");
+  o.data_node = f.section("data");
+  const config::Node train = f.section("train");
   f.finish();
 
   if (o.model.exists()) model_registry().create(o.model);
@@ -27,7 +65,23 @@ RunOptions RunOptions::from(const config::Config& config) {
     if (!o.metrics.is_sequence()) o.metrics.fail("expected a list of metrics");
     for (std::size_t i = 0; i < o.metrics.size(); ++i) metric_registry().create(o.metrics[i]);
   }
+  if (o.data_node.exists()) o.data = DataOptions::from(o.data_node);
+  o.train = TrainOptions::from(train);
   return o;
+}
+
+void RunOptions::require_training_sections(const config::Config& config) const {
+  const std::pair<const config::Node*, const char*> sections[] = {
+      {&model, "model: {type: ...}"},
+      {&losses, "losses: [{type: kl, weight: 1.0}, ...]"},
+      {&data_node, "data: {file: <dataset .h5>, split: random, distance: hollow_dist}"}};
+  for (const auto& [node, example] : sections) {
+    if (!node->exists() || node->is_null()) {
+      throw ConfigError(config.source() + ": training needs a '" +
+                        std::string(example).substr(0, std::string(example).find(':')) +
+                        "' section, e.g. " + example);
+    }
+  }
 }
 
 }  // namespace skinlab::train

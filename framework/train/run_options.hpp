@@ -12,6 +12,21 @@
 ///     model: {type: ...}              # `model` registry
 ///     losses: [{type: kl, weight: 1}] # `loss` registry, weighted sum
 ///     metrics: [{type: ...}]          # `metric` registry
+///     data:                           # what `skinlab train` / `skinlab eval` read
+///       file: results/datasets/zeroad.h5  # a prepared dataset (skinlab prepare)
+///       split: random                 # a split of that file: /splits/<split>/{train,val,test}
+///       distance: hollow_dist         # distance type of the top-K candidates and 1/D inputs
+///     train:                          # HeterSkinNet Sec. 4.2
+///       epochs: 100
+///       lr: 1.0e-4                    # Adam
+///       weight_decay: 1.0e-4
+///       patience: 10                  # early stopping on the validation loss; 0 = off
+///       min_delta: 0                  # an improvement smaller than this does not count
+///       max_characters_per_epoch: 0   # 0 = the whole train split (smoke runs use a few)
+///       log_every: 100                # a progress line every this many steps; 0 = per epoch
+///
+/// `data` and `train` are optional here so that `skinlab config` validates any experiment config;
+/// `skinlab train` requires `model`, `losses` and `data`.
 
 #include <cstdint>
 #include <string>
@@ -19,6 +34,36 @@
 #include "framework/core/config.hpp"
 
 namespace skinlab::train {
+
+/// The `data:` section.
+struct DataOptions {
+  std::string file;                   ///< dataset file (relative paths: to the working directory)
+  std::string split = "random";       ///< name of a split stored in the file
+  std::string distance = "hollow_dist";  ///< a `distance` registry key the file was prepared with
+
+  /// Decodes and checks a `data:` map (`file` required; `distance` must be a registered
+  /// distance type). Errors name the file, line and key.
+  static DataOptions from(const config::Node& node);
+};
+
+/// The `train:` section (HeterSkinNet Sec. 4.2: Adam, lr 1e-4, weight decay 1e-4, one character
+/// per step).
+struct TrainOptions {
+  int epochs = 100;
+  double lr = 1e-4;
+  double weight_decay = 1e-4;
+  /// Stop when the validation loss has not improved (by more than `min_delta`) for this many
+  /// epochs; 0 disables early stopping.
+  int patience = 10;
+  double min_delta = 0.0;
+  /// Train on the first this many characters of each epoch's shuffled order; 0 = all.
+  int max_characters_per_epoch = 0;
+  /// A progress line (loss, rate, ETA) every this many steps; 0 = only the per-epoch line.
+  int log_every = 100;
+
+  /// Decodes and checks a `train:` map (every field optional). Errors name the file, line and key.
+  static TrainOptions from(const config::Node& node);
+};
 
 struct RunOptions {
   std::string experiment;
@@ -29,10 +74,17 @@ struct RunOptions {
   config::Node model;    ///< missing when the config has no model section
   config::Node losses;   ///< missing when the config has no losses section
   config::Node metrics;  ///< missing when the config has no metrics section
+  config::Node data_node;   ///< the `data:` section (missing when absent)
+  DataOptions data;         ///< decoded `data:` (defaults when absent)
+  TrainOptions train;       ///< decoded `train:` (defaults when absent)
 
   /// Reads and validates the whole config (see the file comment). Throws ConfigError or
   /// RegistryError with the file, line and key path of the first problem.
   static RunOptions from(const config::Config& config);
+
+  /// Throws ConfigError naming the config file unless the sections training and evaluation need
+  /// (`model`, `losses`, `data`) are present.
+  void require_training_sections(const config::Config& config) const;
 };
 
 }  // namespace skinlab::train

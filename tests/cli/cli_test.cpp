@@ -51,11 +51,11 @@ TEST(Cli, InfoListsEveryRegistry) {
 }
 
 TEST(Cli, ConfigPrintsTheMergedResultWithOverrides) {
-  const Result r = run("config configs/ablations/wo_smoothing.yaml seed=3 losses.0.weight=2");
+  const Result r = run("config configs/ablations/no_smoothing.yaml seed=3 losses.0.weight=2");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("seed: 3"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("results_dir: results"), std::string::npos) << r.out;  // from base.yaml
-  EXPECT_NE(r.out.find("experiment: heterskinnet_wo_smoothing"), std::string::npos);
+  EXPECT_NE(r.out.find("experiment: heterskinnet_no_smoothing"), std::string::npos);
   EXPECT_NE(r.out.find("weight: 2"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("laplacian_smoothing"), std::string::npos) << "list must be replaced";
   EXPECT_EQ(r.out.find("_base_"), std::string::npos);
@@ -79,10 +79,20 @@ TEST(Cli, UnknownTypeListsTheKnownTypes) {
   EXPECT_NE(r.err.find("losses[1]: unknown loss type 'laplacian'; known loss types: kl, "
                        "laplacian_smoothing, mse, soft_cross_entropy"),
             std::string::npos) << r.err;
-  const Result m = run("config configs/heterskinnet.yaml model.type=heterskinnet");
+  const Result m = run("config configs/heterskinnet.yaml model.type=heterskinet");
   EXPECT_EQ(m.status, 1);
-  EXPECT_NE(m.err.find("override 'model.type=heterskinnet'"), std::string::npos) << m.err;
-  EXPECT_NE(m.err.find("unknown model type 'heterskinnet'"), std::string::npos) << m.err;
+  EXPECT_NE(m.err.find("unknown model type 'heterskinet'; known model types: heterskinnet"),
+            std::string::npos) << m.err;
+}
+
+TEST(Cli, ConfigValidatesTheMetricsOfBaseYaml) {
+  const Result ok = run("config configs/heterskinnet.yaml");
+  ASSERT_EQ(ok.status, 0) << ok.err;
+  EXPECT_NE(ok.out.find("type: deformation_error"), std::string::npos) << ok.out;
+  const Result bad = run("config configs/heterskinnet.yaml metrics.0.average=mean");
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_NE(bad.err.find("average: must be 'entries' or 'vertices', got 'mean'"),
+            std::string::npos) << bad.err;
 }
 
 TEST(Cli, WrongTypeMissingFileAndBadUsage) {
@@ -152,6 +162,51 @@ TEST(Cli, PrepareAndDatasetInfoOnTheMinetestConfig) {
                           " preprocess.topk=2");
   EXPECT_EQ(typo.status, 1);
   EXPECT_NE(typo.err.find("preprocess.topk: unknown field"), std::string::npos) << typo.err;
+}
+
+TEST(Cli, TrainAndEvalReportBadInputsBeforeCreatingARun) {
+  TempDir dir;
+  const std::string base = "_base_: " + std::string(SKINLAB_SOURCE_DIR) + "/configs/base.yaml\n" +
+                           "experiment: cli_train\nresults_dir: " + (dir / "results").string() +
+                           "\nlosses: [{type: kl}]\n";
+  const auto no_model = dir.write("no_model.yaml", base + "data: {file: " + (dir / "d.h5").string() + "}\n");
+  const Result m = run("train " + no_model.string());
+  EXPECT_EQ(m.status, 1);
+  EXPECT_NE(m.err.find("no_model.yaml: training needs a 'model' section"), std::string::npos) << m.err;
+
+  const Result lr = run("train " + no_model.string() + " train.lr=0");
+  EXPECT_EQ(lr.status, 1);
+  EXPECT_NE(lr.err.find("train.lr: must be a positive number"), std::string::npos) << lr.err;
+
+  const auto bad_key = dir.write("bad_key.yaml", base + "train:\n  epocs: 3\n");
+  const Result k = run("train " + bad_key.string());
+  EXPECT_EQ(k.status, 1);
+  EXPECT_NE(k.err.find("bad_key.yaml:6: train.epocs: unknown field of the train section"),
+            std::string::npos) << k.err;
+
+  const auto unknown = dir.write("unknown.yaml", base + "model: {type: no_such_model}\n");
+  const Result u = run("train " + unknown.string());
+  EXPECT_EQ(u.status, 1);
+  EXPECT_NE(u.err.find("unknown model type 'no_such_model'"), std::string::npos) << u.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "results")) << "no run directory on errors";
+
+  const Result none = run("train");
+  EXPECT_EQ(none.status, 1);
+  EXPECT_NE(none.err.find("give an experiment config, or --resume <run_dir>"), std::string::npos);
+  const Result resume = run("train --resume " + (dir / "nowhere").string());
+  EXPECT_EQ(resume.status, 1);
+  EXPECT_NE(resume.err.find("nowhere: run directory does not exist"), std::string::npos) << resume.err;
+
+  const Result e = run("eval " + (dir / "nowhere").string());
+  EXPECT_EQ(e.status, 1);
+  EXPECT_NE(e.err.find("nowhere: run directory does not exist"), std::string::npos) << e.err;
+  dir.write("run/config.yaml", "experiment: x\n");
+  const Result c = run("eval " + (dir / "run").string() + " --checkpoint first");
+  EXPECT_EQ(c.status, 1);
+  EXPECT_NE(c.err.find("unknown checkpoint 'first'; choose best or last"), std::string::npos) << c.err;
+  const Result o = run("train --resume " + (dir / "run").string() + " seed=3");
+  EXPECT_EQ(o.status, 1);
+  EXPECT_NE(o.err.find("overrides would change the run's config"), std::string::npos) << o.err;
 }
 
 }  // namespace

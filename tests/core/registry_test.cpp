@@ -103,10 +103,10 @@ TEST(Registry, ExactKeysOfEveryCategory) {
   for (const auto* registry : all_registries()) actual[registry->name()] = registry->keys();
   const std::map<std::string, std::vector<std::string>> expected = {
       {"distance", {"euclidean", "hollow_dist", "volumetric_geodesic"}},
-      {"graph_op", {}},
-      {"model", {}},
+      {"graph_op", {"b2v", "edge_conv", "global_pool", "mesh_conv", "v2b"}},
+      {"model", {"heterskinnet"}},
       {"loss", {"kl", "laplacian_smoothing", "mse", "soft_cross_entropy"}},
-      {"metric", {}},
+      {"metric", {"avg_l1", "deformation_error", "precision_recall"}},
       {"dataset", {"cube2", "folder", "nexuiz", "zeroad"}},
   };
   EXPECT_EQ(actual, expected);

@@ -80,26 +80,69 @@ TEST(Lbs, ShapeMismatchIsAnError) {
       {"1 rotations for 2 joints"});
 }
 
-TEST(Lbs, RandomPoseRotatesAboutAFractionOfJoints) {
+Skeleton chain(int n) {
   Skeleton s;
-  for (int j = 0; j < 200; ++j) {
+  for (int j = 0; j < n; ++j) {
     s.names.push_back("j" + std::to_string(j));
     s.parents.push_back(j - 1);
   }
-  s.positions = Eigen::MatrixXd::Random(200, 3);
+  s.positions = Eigen::MatrixXd::Random(n, 3);
+  return s;
+}
+
+int count_rotated(const std::vector<Eigen::Matrix3d>& pose) {
+  int rotated = 0;
+  for (const auto& R : pose) rotated += !R.isIdentity();
+  return rotated;
+}
+
+TEST(Lbs, RandomPoseRotatesAnExactFractionOfJoints) {
+  const Skeleton s = chain(200);
   std::mt19937 a(7), b(7);
   const auto pose = random_pose(s, a);
   EXPECT_EQ(pose, random_pose(s, b));  // seeded: reproducible
-  int rotated = 0;
   for (const auto& R : pose) {
     EXPECT_TRUE((R * R.transpose()).isIdentity(1e-12));
     EXPECT_NEAR(R.determinant(), 1.0, 1e-12);
-    rotated += !R.isIdentity();
   }
-  EXPECT_GT(rotated, 30);  // Binomial(200, 0.3): mean 60, sd 6.5
-  EXPECT_LT(rotated, 90);
+  EXPECT_EQ(count_rotated(pose), 60);  // round(0.3 · 200)
+  // round(0.3 · 10) = 3 on every draw, and the chosen joints vary between draws.
+  const Skeleton small = chain(10);
   std::mt19937 c(1);
+  std::vector<int> times_chosen(10, 0);
+  for (int trial = 0; trial < 200; ++trial) {
+    const auto p = random_pose(small, c);
+    EXPECT_EQ(count_rotated(p), 3);
+    for (int j = 0; j < 10; ++j) times_chosen[j] += !p[j].isIdentity();
+  }
+  for (int j = 0; j < 10; ++j) EXPECT_GT(times_chosen[j], 30) << j;  // mean 60, sd 6.5
   for (const auto& R : random_pose(s, c, 0.0)) EXPECT_TRUE(R.isIdentity());
+  EXPECT_EQ(count_rotated(random_pose(s, c, 1.0)), 200);
+}
+
+TEST(Lbs, RandomPoseAnglesFollowTheRequestedSpread) {
+  // Rotation angles are |N(0, σ²)|: mean σ·√(2/π) and mean square σ².
+  const Skeleton s = chain(1000);
+  std::mt19937 rng(3);
+  double sum = 0, sum_sq = 0;
+  int n = 0;
+  for (int trial = 0; trial < 10; ++trial) {
+    for (const auto& R : random_pose(s, rng, 1.0, 25.0)) {
+      const double degrees = Eigen::AngleAxisd(R).angle() * 180 / M_PI;
+      sum += degrees, sum_sq += degrees * degrees, ++n;
+    }
+  }
+  EXPECT_NEAR(sum / n, 25.0 * std::sqrt(2 / M_PI), 0.3);  // standard error ≈ 0.19
+  EXPECT_NEAR(std::sqrt(sum_sq / n), 25.0, 0.3);
+}
+
+TEST(Lbs, RandomPoseRejectsBadArguments) {
+  const Skeleton s = chain(3);
+  std::mt19937 rng(0);
+  skinlab::testing::expect_error<GeometryError>([&] { random_pose(s, rng, 1.5); },
+                                                {"fraction must be in [0, 1]", "1.5"});
+  skinlab::testing::expect_error<GeometryError>([&] { random_pose(s, rng, 0.3, -1); },
+                                                {"sigma_degrees"});
 }
 
 }  // namespace

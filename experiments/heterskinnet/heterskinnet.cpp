@@ -1,0 +1,108 @@
+#include "experiments/heterskinnet/heterskinnet.hpp"
+
+#include "framework/core/registry.hpp"
+
+namespace skinlab::experiments {
+
+namespace {
+
+// The paper's architecture (Sec. 3.3, 4.2) as config text, used for any of `stem`, `local`,
+// `global` that a config leaves out.
+constexpr const char* kDefaults = R"(
+stem:
+  - {type: b2v, mlp: [256]}
+  - {type: v2b, mlp: [128]}
+  - {type: mesh_conv, edge_mlp: [256], mlp: [256]}
+  - {type: edge_conv, edges: skeleton, mlp: [128]}
+local:
+  - {type: b2v, mlp: [256]}
+  - {type: v2b, mlp: [128]}
+  - {type: mesh_conv, edge_mlp: [256], mlp: [256]}
+  - {type: edge_conv, edges: skeleton, mlp: [128]}
+  - {type: b2v, mlp: [256]}
+  - {type: v2b, mlp: [128]}
+  - {type: mesh_conv, edge_mlp: [256], mlp: [256]}
+  - {type: edge_conv, edges: skeleton, mlp: [128]}
+global: {type: global_pool, vertex_mlp: [512], bone_mlp: [512], to: [vertex], keep_input: false}
+)";
+
+const config::Config& defaults() {
+  static const config::Config c = config::Config::parse(kDefaults);
+  return c;
+}
+
+}  // namespace
+
+HeterSkinNet::Options HeterSkinNet::Options::from(const config::Node& node) {
+  Options o;
+  config::Fields f(node, "model heterskinnet");
+  f.optional("top_k", o.top_k);
+  f.optional("min_distance", o.min_distance);
+  o.edge_dropout = graph::EdgeDropoutOptions::from(f.section("edge_dropout"));
+  o.stem = f.section("stem");
+  o.local = f.section("local");
+  o.global = f.section("global");
+  f.optional("head", o.head);
+  f.optional("head_dropout", o.head_dropout);
+  f.check(o.top_k >= 1, "top_k", "must be ≥ 1");
+  f.check(o.min_distance > 0, "min_distance", "must be positive");
+  for (auto w : o.head) f.check(w >= 1, "head", "widths must be ≥ 1");
+  f.check(o.head_dropout >= 0 && o.head_dropout < 1, "head_dropout", "must be in [0, 1)");
+  f.finish();
+  if (!o.stem.exists()) o.stem = defaults().root()["stem"];
+  if (!o.local.exists()) o.local = defaults().root()["local"];
+  if (!o.global.exists()) o.global = defaults().root()["global"];
+  // Construct (unbuilt) once here so a bad op node is a ConfigError before any work starts.
+  graph::Sequence::from(o.stem);
+  graph::Sequence::from(o.local);
+  graph::graph_op_from(o.global);
+  return o;
+}
+
+HeterSkinNet::HeterSkinNet(Options options) : options_(std::move(options)) {
+  stem_ = register_module("stem", graph::Sequence::from(options_.stem));
+  local_ = register_module("local", graph::Sequence::from(options_.local));
+  global_ = register_module(
+      "global_branch",
+      graph::graph_op_from(
+          options_.global));  // "global" is a Python keyword: libtorch checkpoints cannot store it
+  const graph::Dims in{options_.top_k + 3, 6, options_.top_k};
+  const graph::Dims x = stem_->build(in);
+  const graph::Dims g = global_->build(x);
+  const graph::Dims l = local_->build(x);
+  TORCH_CHECK(l.vertex >= 1 && l.bone >= 1,
+              "heterskinnet: the local branch must end with vertex and bone features, got widths ",
+              l.vertex, " and ", l.bone);
+  graph::MlpOptions head;
+  head.widths = options_.head;
+  head.widths.push_back(options_.top_k);
+  head.activate_last = false;
+  head.dropout = options_.head_dropout;
+  head_ = register_module(
+      "head", graph::Mlp(l.vertex + options_.top_k * l.bone + g.vertex, std::move(head)));
+}
+
+torch::Tensor HeterSkinNet::forward(const data::CharacterTensors& c) {
+  TORCH_CHECK(c.top_k() == options_.top_k, "heterskinnet: built for top_k = ", options_.top_k,
+              " but character '", c.name, "' has ", c.top_k(),
+              " candidate bones per vertex (set model.top_k to the dataset's top_k)");
+  const std::int64_t nv = c.num_vertices(), k = options_.top_k;
+  graph::Graph g = graph::make_graph(c);
+  if (is_training() && options_.edge_dropout.p > 0) g = graph::drop_edges(g, options_.edge_dropout);
+
+  graph::Features in;
+  in.vertex =
+      torch::cat({c.positions, c.topk_distance.clamp_min(options_.min_distance).reciprocal()}, 1);
+  in.bone = c.bones;
+  const graph::Features x = stem_->forward(in, g);
+  const graph::Features glob = global_->forward(x, g);
+  const graph::Features loc = local_->forward(x, g);
+  const torch::Tensor candidates =
+      loc.bone.index_select(0, c.topk_index.reshape({-1})).reshape({nv, k * loc.bone.size(1)});
+  const torch::Tensor h = torch::cat({loc.vertex, candidates, glob.vertex}, 1);
+  return torch::softmax(head_->forward(h), 1);
+}
+
+}  // namespace skinlab::experiments
+
+SKINLAB_REGISTER(model, heterskinnet, skinlab::experiments::HeterSkinNet);

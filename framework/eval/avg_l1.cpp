@@ -1,0 +1,25 @@
+#include "framework/eval/avg_l1.hpp"
+
+#include "framework/core/registry.hpp"
+#include "framework/eval/weights.hpp"
+
+namespace skinlab::eval {
+
+AvgL1::Options AvgL1::Options::from(const config::Node& node) {
+  Options o;
+  config::Fields f(node, "metric 'avg_l1'");
+  f.optional("prune", o.prune).check(o.prune >= 0 && o.prune <= 1, "prune", "must be in [0, 1]");
+  f.finish();
+  return o;
+}
+
+std::map<std::string, double> AvgL1::operator()(const MetricInputs& in) const {
+  auto [P, G] = read_weights(in, "avg_l1");
+  prune_rows(P, options_.prune);
+  const double total = (P - G).cwiseAbs().sum();
+  return {{"avg_l1", P.rows() > 0 ? total / static_cast<double>(P.rows()) : 0.0}};
+}
+
+}  // namespace skinlab::eval
+
+SKINLAB_REGISTER(metric, avg_l1, skinlab::eval::AvgL1);

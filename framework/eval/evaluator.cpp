@@ -1,0 +1,193 @@
+#include "framework/eval/evaluator.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <set>
+
+#include "framework/core/atomic_file.hpp"
+#include "framework/core/config.hpp"
+#include "framework/core/error.hpp"
+#include "framework/core/progress.hpp"
+#include "framework/core/registry.hpp"
+#include "framework/data/tensors.hpp"
+#include "framework/eval/metric.hpp"
+#include "framework/eval/predictions.hpp"
+#include "framework/losses/loss.hpp"
+#include "framework/models/model.hpp"
+#include "framework/train/checkpoint.hpp"
+#include "framework/train/run_data.hpp"
+#include "framework/train/trainer.hpp"
+
+namespace skinlab::eval {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
+/// Column order: loss first, then the metrics' names in sorted order.
+std::vector<std::string> columns(const std::vector<CharacterResult>& characters) {
+  std::set<std::string> names;
+  for (const auto& c : characters)
+    for (const auto& [name, v] : c.values) names.insert(name);
+  std::vector<std::string> out;
+  if (names.erase("loss")) out.push_back("loss");
+  out.insert(out.end(), names.begin(), names.end());
+  return out;
+}
+
+}  // namespace
+
+std::map<std::string, double> mean_values(const std::vector<CharacterResult>& characters) {
+  std::map<std::string, std::pair<double, int>> sums;
+  for (const auto& c : characters) {
+    for (const auto& [name, value] : c.values) {
+      auto& [sum, n] = sums[name];
+      sum += value;
+      ++n;
+    }
+  }
+  std::map<std::string, double> out;
+  for (const auto& [name, s] : sums) out[name] = s.first / s.second;
+  return out;
+}
+
+EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  if (options.checkpoint != "best" && options.checkpoint != "last") {
+    throw Error("unknown checkpoint '" + options.checkpoint + "'; choose best or last");
+  }
+  const config::Config config = config::Config::load(run.file("config.yaml"), options.overrides);
+  const train::RunOptions o = train::RunOptions::from(config);
+  o.require_training_sections(config);
+  const fs::path checkpoint = run.file(options.checkpoint + ".pt");
+  if (!fs::exists(checkpoint)) {
+    throw IoError(checkpoint.string() + ": no checkpoint '" + options.checkpoint +
+                  "' in this run (a run writes best.pt and last.pt after its first epoch)");
+  }
+
+  train::RunData data(o.data);
+  const std::vector<int>& indices = data.part(options.part);
+  if (indices.empty()) {
+    throw Error(o.data.file + ": part '" + options.part + "' of split '" + o.data.split +
+                "' has no characters");
+  }
+  const auto model = train::build_model(o);
+  const train::TrainingState state = train::load_checkpoint(checkpoint, *model);
+  const losses::LossSum loss = losses::LossSum::from(o.losses);
+  std::vector<std::shared_ptr<Metric>> metrics;
+  if (o.metrics.exists()) {
+    for (std::size_t i = 0; i < o.metrics.size(); ++i) metrics.push_back(metric_registry().create(o.metrics[i]));
+  }
+
+  EvalReport report;
+  report.split = o.data.split;
+  report.part = options.part;
+  report.checkpoint = options.checkpoint;
+  report.epoch = static_cast<int>(state.epoch);
+
+  std::unique_ptr<PredictionFile> h5;
+  const fs::path predictions = run.file("predictions");
+  const fs::path rig_dir = predictions / options.part;
+  if (options.predictions) {
+    fs::create_directories(rig_dir);
+    report.predictions = predictions;
+    h5 = std::make_unique<PredictionFile>(predictions / (options.part + ".h5"));
+  }
+
+  model->eval();
+  torch::NoGradGuard no_grad;
+  Progress progress("eval " + options.part, indices.size());
+  for (int index : indices) {
+    const data::PreparedCharacter& character = data.dataset().characters[static_cast<std::size_t>(index)];
+    const data::CharacterTensors& c = data.tensors(index);
+    const torch::Tensor pred = model->forward(c);
+    train::check_prediction(pred, c, o);
+    const torch::Tensor weights = data::scatter_to_bones(pred, c.topk_index, c.num_bones());
+
+    CharacterResult r;
+    r.name = c.name;
+    r.vertices = static_cast<int>(c.num_vertices());
+    r.bones = static_cast<int>(c.num_bones());
+    losses::LossInputs in;
+    in.pred = weights;
+    in.target = data::scatter_to_bones(c.targets, c.topk_index, c.num_bones());
+    in.laplacian = c.laplacian;
+    r.values["loss"] = loss(in).item<double>();
+    MetricInputs mi;
+    mi.pred = weights;
+    mi.target = c.bone_weights;
+    mi.character = &character;
+    for (const auto& metric : metrics) {
+      for (const auto& [name, value] : (*metric)(mi)) r.values[name] = value;
+    }
+    report.characters.push_back(std::move(r));
+
+    if (h5) {
+      const data::RowMatrixXf source = to_source_vertices(to_eigen(weights), character.vertex_map);
+      write_rig_prediction(rig_dir / (character.name + "_rig.txt"), character, source);
+      h5->add(character, o.data.distance, pred, weights, source);
+    }
+    progress.tick();
+  }
+  progress.finish();
+  report.mean = mean_values(report.characters);
+
+  if (h5) {
+    h5->set_attribute("experiment", o.experiment);
+    h5->set_attribute("run", run.id());
+    h5->set_attribute("split", o.data.split);
+    h5->set_attribute("part", options.part);
+    h5->set_attribute("checkpoint", options.checkpoint);
+    h5->set_attribute("epoch", static_cast<std::int64_t>(state.epoch));
+    h5->set_attribute("distance", o.data.distance);
+    h5->commit();
+  }
+
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  nlohmann::json per_character = nlohmann::json::array();
+  for (const auto& c : report.characters) {
+    per_character.push_back(
+        {{"character", c.name}, {"vertices", c.vertices}, {"bones", c.bones}, {"values", c.values}});
+  }
+  const nlohmann::json out = {{"experiment", o.experiment},
+                              {"run", run.id()},
+                              {"dataset", o.data.file},
+                              {"split", o.data.split},
+                              {"part", options.part},
+                              {"distance", o.data.distance},
+                              {"checkpoint", options.checkpoint},
+                              {"epoch", state.epoch},
+                              {"characters", report.characters.size()},
+                              {"mean", report.mean},
+                              {"per_character", per_character},
+                              {"seconds", report.seconds}};
+  report.json = run.file("eval_" + options.part + ".json");
+  write_file_atomic(report.json, out.dump(2) + "\n");
+
+  const std::vector<std::string> names = columns(report.characters);
+  std::string csv = "character,vertices,bones";
+  for (const auto& name : names) csv += "," + csv_field(name);
+  csv += "\n";
+  for (const auto& c : report.characters) {
+    csv += fmt::format("{},{},{}", csv_field(c.name), c.vertices, c.bones);
+    for (const auto& name : names) {
+      const auto it = c.values.find(name);
+      csv += it == c.values.end() ? std::string(",") : fmt::format(",{}", it->second);
+    }
+    csv += "\n";
+  }
+  report.csv = run.file("eval_" + options.part + ".csv");
+  write_file_atomic(report.csv, csv);
+  return report;
+}
+
+}  // namespace skinlab::eval

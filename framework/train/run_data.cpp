@@ -1,0 +1,57 @@
+#include "framework/train/run_data.hpp"
+
+#include "framework/core/error.hpp"
+
+namespace skinlab::train {
+
+namespace {
+
+data::Dataset read(const DataOptions& options) {
+  try {
+    return data::read_dataset(options.file);
+  } catch (const IoError& e) {
+    throw IoError(std::string(e.what()) + " (data.file)");
+  }
+}
+
+}  // namespace
+
+RunData::RunData(const DataOptions& options) : options_(options), dataset_(read(options)) {
+  const auto it = dataset_.splits.find(options.split);
+  if (it == dataset_.splits.end()) {
+    std::string have;
+    for (const auto& [name, split] : dataset_.splits) have += (have.empty() ? "" : ", ") + name;
+    throw IoError(options.file + ": no split '" + options.split + "' (data.split); the file has " +
+                  (have.empty() ? "no splits" : "the splits: " + have));
+  }
+  split_ = it->second;
+}
+
+const std::vector<int>& RunData::part(const std::string& name) const {
+  if (name == "train") return split_.train;
+  if (name == "val") return split_.val;
+  if (name == "test") return split_.test;
+  throw Error("unknown split part '" + name + "'; a split has the parts train, val and test");
+}
+
+const data::CharacterTensors& RunData::tensors(int index) {
+  auto it = tensors_.find(index);
+  if (it == tensors_.end()) {
+    try {
+      it = tensors_
+               .emplace(index, data::to_tensors(
+                                   dataset_.characters.at(static_cast<std::size_t>(index)),
+                                   options_.distance))
+               .first;
+    } catch (const IoError& e) {
+      throw IoError(options_.file + ": " + e.what() + " (data.distance)");
+    }
+  }
+  return it->second;
+}
+
+void RunData::convert(const std::string& name) {
+  for (int index : part(name)) tensors(index);
+}
+
+}  // namespace skinlab::train

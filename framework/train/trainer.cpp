@@ -1,0 +1,341 @@
+#include "framework/train/trainer.hpp"
+
+#include <ATen/CPUGeneratorImpl.h>
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cmath>
+#include <mutex>
+
+#include "framework/core/environment.hpp"
+#include "framework/core/error.hpp"
+#include "framework/core/progress.hpp"
+#include "framework/core/registry.hpp"
+
+namespace skinlab::train {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+RunOptions validated(const config::Config& config) {
+  RunOptions o = RunOptions::from(config);
+  o.require_training_sections(config);
+  return o;
+}
+
+torch::Tensor get_rng_state(at::Generator generator) {
+  std::lock_guard<std::mutex> lock(generator.mutex());
+  return generator.get_state();
+}
+
+void set_rng_state(at::Generator& generator, const torch::Tensor& state) {
+  std::lock_guard<std::mutex> lock(generator.mutex());
+  generator.set_state(state);
+}
+
+/// The training order's generator: its own stream, so a model that draws more or fewer random
+/// numbers (dropout on or off) still sees the characters in the same order.
+std::uint64_t order_seed(std::int64_t seed) {
+  return static_cast<std::uint64_t>(seed) * 0x9E3779B97F4A7C15ull + 0x6A09E667F3BCC909ull;
+}
+
+std::string duration(double seconds) {
+  const long s = std::lround(std::max(0.0, seconds));
+  return fmt::format("{}:{:02}:{:02}", s / 3600, s / 60 % 60, s % 60);
+}
+
+std::string parts_text(const std::map<std::string, double>& parts) {
+  std::string out;
+  for (const auto& [name, value] : parts) out += fmt::format("{}{} {:.5g}", out.empty() ? "" : ", ", name, value);
+  return out;
+}
+
+nlohmann::json parts_json(const std::map<std::string, double>& parts) {
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& [name, value] : parts) out[name] = value;
+  return out;
+}
+
+/// Files a killed process left while writing (AtomicPath's `.<name>.tmp-<pid>-<n>`).
+void remove_stale_temporaries(const RunDir& run) {
+  for (const auto& entry : fs::directory_iterator(run.path())) {
+    const std::string name = entry.path().filename().string();
+    for (const char* target : {kLastCheckpoint, kBestCheckpoint, "metrics.jsonl"}) {
+      if (name.rfind("." + std::string(target) + ".tmp-", 0) == 0) {
+        spdlog::warn("removing {} left by an interrupted write", entry.path().string());
+        fs::remove(entry.path());
+      }
+    }
+  }
+}
+
+/// Keeps the records of epochs ≤ `epoch` (a killed run may have logged an epoch whose
+/// checkpoint it never wrote; that epoch is trained again).
+void truncate_metrics(const RunDir& run, std::int64_t epoch) {
+  const fs::path file = run.file("metrics.jsonl");
+  if (!fs::exists(file)) return;
+  std::string kept;
+  std::size_t dropped = 0;
+  for (const auto& record : run.read_metrics()) {
+    if (record.contains("epoch") && record["epoch"].is_number_integer() &&
+        record["epoch"].get<std::int64_t>() > epoch) {
+      ++dropped;
+      continue;
+    }
+    kept += record.dump() + "\n";
+  }
+  if (dropped > 0) {
+    spdlog::info("dropping {} metrics record(s) after epoch {} (not checkpointed)", dropped, epoch);
+    write_file_atomic(file, kept);
+  }
+}
+
+}  // namespace
+
+std::shared_ptr<models::Model> build_model(const RunOptions& options) {
+  torch::manual_seed(static_cast<std::uint64_t>(options.seed));
+  return model_registry().create(options.model);
+}
+
+void check_prediction(const torch::Tensor& prediction, const data::CharacterTensors& c,
+                      const RunOptions& options) {
+  const bool ok = prediction.defined() && prediction.dim() == 2 &&
+                  prediction.size(0) == c.num_vertices() && prediction.size(1) == c.top_k() &&
+                  prediction.scalar_type() == torch::kFloat32;
+  if (!ok) {
+    throw Error(fmt::format(
+        "model '{}' returned {} for character '{}'; expected a float32 #V×K = {}×{} distribution "
+        "over the {} candidates (is the model's top_k the dataset's K?)",
+        options.model["type"].as<std::string>(),
+        prediction.defined() ? fmt::format("a {} tensor of shape {}", c10::toString(prediction.scalar_type()),
+                                           fmt::join(prediction.sizes(), "×"))
+                             : "an undefined tensor",
+        c.name, c.num_vertices(), c.top_k(), c.distance));
+  }
+}
+
+RunDir create_run(const config::Config& config, const RunOptions& options,
+                  const std::string& run_id, const std::vector<std::string>& command) {
+  RunDir run = RunDir::create(options.results_dir, options.experiment, run_id);
+  run.write_config(config.to_yaml());
+  run.write_env(collect_environment(static_cast<std::uint64_t>(options.seed), command));
+  return run;
+}
+
+Trainer::Trainer(const config::Config& config)
+    : config_(config), options_(validated(config)), data_(options_.data) {
+  if (data_.part("train").empty()) {
+    throw IoError(options_.data.file + ": split '" + options_.data.split +
+                  "' has no training characters");
+  }
+  data_.convert("train");
+  data_.convert("val");
+  model_ = build_model(options_);
+  check_checkpointable(*model_);
+  initial_torch_rng_ = get_rng_state(at::detail::getDefaultCPUGenerator());
+  loss_ = losses::LossSum::from(options_.losses);
+  const auto parameters = model_->parameters();
+  if (parameters.empty()) {
+    options_.model.fail("model '" + options_.model["type"].as<std::string>() +
+                        "' has no trainable parameters");
+  }
+  optimizer_ = std::make_unique<torch::optim::Adam>(
+      parameters,
+      torch::optim::AdamOptions(options_.train.lr).weight_decay(options_.train.weight_decay));
+}
+
+torch::Tensor Trainer::loss_of(const data::CharacterTensors& c, const torch::Tensor& pred,
+                               std::map<std::string, double>* parts) const {
+  check_prediction(pred, c, options_);
+  losses::LossInputs in;
+  in.pred = data::scatter_to_bones(pred, c.topk_index, c.num_bones());
+  in.target = data::scatter_to_bones(c.targets, c.topk_index, c.num_bones());
+  in.laplacian = c.laplacian;
+  return loss_(in, parts);
+}
+
+double Trainer::step(int index, std::map<std::string, double>& parts) {
+  const data::CharacterTensors& c = data_.tensors(index);
+  optimizer_->zero_grad();
+  std::map<std::string, double> step_parts;
+  torch::Tensor loss = loss_of(c, model_->forward(c), &step_parts);
+  const double value = loss.item<double>();
+  if (!std::isfinite(value)) {
+    throw Error(fmt::format("training loss is {} on character '{}' ({}); lower train.lr?", value,
+                            c.name, parts_text(step_parts)));
+  }
+  loss.backward();
+  optimizer_->step();
+  for (const auto& [name, v] : step_parts) parts[name] += v;
+  return value;
+}
+
+double Trainer::mean_loss(const std::string& part, std::map<std::string, double>* parts) {
+  const std::vector<int>& indices = data_.part(part);
+  const bool was_training = model_->is_training();
+  model_->eval();
+  torch::NoGradGuard no_grad;
+  double total = 0;
+  std::map<std::string, double> sums;
+  for (int index : indices) {
+    const data::CharacterTensors& c = data_.tensors(index);
+    std::map<std::string, double> p;
+    total += loss_of(c, model_->forward(c), &p).item<double>();
+    for (const auto& [name, v] : p) sums[name] += v;
+  }
+  model_->train(was_training);
+  const double n = static_cast<double>(std::max<std::size_t>(indices.size(), 1));
+  if (parts) {
+    parts->clear();
+    for (const auto& [name, v] : sums) (*parts)[name] = v / n;
+  }
+  return indices.empty() ? std::nan("") : total / n;
+}
+
+TrainResult Trainer::fit(const RunDir& run, const FitLimits& limits) {
+  if (fitted_) throw Error("Trainer::fit: a Trainer trains once; build a new one");
+  fitted_ = true;
+  const auto start = Clock::now();
+  const TrainOptions& t = options_.train;
+  TrainResult result;
+
+  at::Generator torch_rng = at::detail::getDefaultCPUGenerator();
+  at::Generator order_rng = at::make_generator<at::CPUGeneratorImpl>(order_seed(options_.seed));
+
+  remove_stale_temporaries(run);
+  TrainingState state;
+  state.seed = options_.seed;
+  state.threads = torch_threads();
+  state.model_config = options_.model.to_yaml();
+  const fs::path last = run.file(kLastCheckpoint);
+  if (fs::exists(last)) {
+    const TrainingState saved = load_checkpoint(last, *model_, optimizer_.get());
+    if (saved.seed != options_.seed) {
+      throw Error(last.string() + ": checkpoint was trained with seed " +
+                  std::to_string(saved.seed) + ", the config says " +
+                  std::to_string(options_.seed));
+    }
+    if (saved.threads != state.threads) {
+      spdlog::warn("{} was written with {} threads, resuming with {}: the result may differ in "
+                   "the last bits from an uninterrupted run",
+                   last.string(), saved.threads, state.threads);
+    }
+    state.epoch = saved.epoch;
+    state.best_epoch = saved.best_epoch;
+    state.best_loss = saved.best_loss;
+    set_rng_state(torch_rng, saved.torch_rng);
+    set_rng_state(order_rng, saved.order_rng);
+    result.resumed = true;
+    spdlog::info("resuming {} after epoch {} (best epoch {}, loss {:.6g})", run.path().string(),
+                 state.epoch, state.best_epoch, state.best_loss);
+  } else {
+    set_rng_state(torch_rng, initial_torch_rng_);
+  }
+  truncate_metrics(run, state.epoch);
+
+  const std::vector<int>& train = data_.part("train");
+  const bool have_val = !data_.part("val").empty();
+  if (!have_val) {
+    spdlog::warn("split '{}' has no validation characters: best.pt and early stopping use the "
+                 "train loss", options_.data.split);
+  }
+  const std::size_t per_epoch =
+      t.max_characters_per_epoch > 0
+          ? std::min<std::size_t>(train.size(), static_cast<std::size_t>(t.max_characters_per_epoch))
+          : train.size();
+  auto stopped_early = [&] {
+    return t.patience > 0 && state.best_epoch > 0 && state.epoch - state.best_epoch >= t.patience;
+  };
+  if (state.epoch >= t.epochs || stopped_early()) {
+    spdlog::info("nothing to train: the run has finished ({} epochs{})", state.epoch,
+                 stopped_early() ? ", stopped early" : "");
+  }
+
+  model_->train();
+  const auto session_start = Clock::now();
+  while (state.epoch < t.epochs && !stopped_early()) {
+    const std::int64_t epoch = state.epoch + 1;
+    const auto epoch_start = Clock::now();
+    const torch::Tensor order = torch::randperm(static_cast<std::int64_t>(train.size()), order_rng,
+                                                torch::TensorOptions().dtype(torch::kInt64));
+    const auto* order_data = order.data_ptr<std::int64_t>();
+
+    double train_sum = 0;
+    std::map<std::string, double> train_parts;
+    const std::string label = fmt::format("epoch {}/{}", epoch, t.epochs);
+    for (std::size_t s = 0; s < per_epoch; ++s) {
+      train_sum += step(train[static_cast<std::size_t>(order_data[s])], train_parts);
+      if (t.log_every > 0 && (s + 1) % static_cast<std::size_t>(t.log_every) == 0 &&
+          s + 1 < per_epoch) {
+        const double elapsed = std::chrono::duration<double>(Clock::now() - epoch_start).count();
+        spdlog::info("{} loss {:.5g}", Progress::format(label, s + 1, per_epoch, elapsed),
+                     train_sum / static_cast<double>(s + 1));
+      }
+    }
+    const double n = static_cast<double>(per_epoch);
+    const double train_loss = train_sum / n;
+    for (auto& [name, v] : train_parts) v /= n;
+
+    std::map<std::string, double> val_parts;
+    const double val_loss = have_val ? mean_loss("val", &val_parts) : std::nan("");
+    const double selection = have_val ? val_loss : train_loss;
+    const bool improved = std::isfinite(selection) &&
+                          (state.best_epoch == 0 || selection < state.best_loss - t.min_delta);
+    state.epoch = epoch;
+    if (improved) {
+      state.best_epoch = epoch;
+      state.best_loss = selection;
+    }
+    state.torch_rng = get_rng_state(torch_rng);
+    state.order_rng = get_rng_state(order_rng);
+    const double seconds = std::chrono::duration<double>(Clock::now() - epoch_start).count();
+
+    // Metrics first, then checkpoints: a kill in between leaves a record without its checkpoint,
+    // which the resumed run drops and writes again.
+    nlohmann::json record = {{"epoch", epoch},
+                             {"train_loss", train_loss},
+                             {"train_parts", parts_json(train_parts)},
+                             {"val_loss", have_val ? nlohmann::json(val_loss) : nlohmann::json()},
+                             {"val_parts", parts_json(val_parts)},
+                             {"best_epoch", state.best_epoch},
+                             {"best_loss", state.best_loss},
+                             {"improved", improved},
+                             {"characters", per_epoch},
+                             {"lr", t.lr},
+                             {"seconds", seconds}};
+    run.append_metrics(record);
+    if (improved) save_checkpoint(run.file(kBestCheckpoint), *model_, optimizer_.get(), state);
+    save_checkpoint(last, *model_, optimizer_.get(), state);
+    ++result.epochs_this_call;
+
+    const double session = std::chrono::duration<double>(Clock::now() - session_start).count();
+    const double eta = session / result.epochs_this_call * static_cast<double>(t.epochs - epoch);
+    spdlog::info("{}: train loss {:.5g} ({}){} | {:.1f} s, ETA {}{}", label, train_loss,
+                 parts_text(train_parts),
+                 have_val ? fmt::format(", val loss {:.5g} ({})", val_loss, parts_text(val_parts))
+                          : std::string(),
+                 seconds, duration(eta), improved ? " *best*" : "");
+
+    if (limits.stop_after_epochs > 0 && result.epochs_this_call >= limits.stop_after_epochs &&
+        state.epoch < t.epochs) {
+      result.interrupted = true;
+      break;
+    }
+  }
+  result.early_stopped = stopped_early() && state.epoch < t.epochs;
+  if (result.early_stopped && !result.interrupted) {
+    spdlog::info("early stopping after epoch {}: no improvement for {} epochs (best epoch {})",
+                 state.epoch, t.patience, state.best_epoch);
+  }
+  result.epochs = static_cast<int>(state.epoch);
+  result.best_epoch = static_cast<int>(state.best_epoch);
+  result.best_loss = state.best_loss;
+  result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  return result;
+}
+
+}  // namespace skinlab::train

@@ -1,0 +1,107 @@
+// The `heterskinnet` model (experiments/heterskinnet/) trained end to end through the Trainer on
+// small synthetic tubes, and the shipped experiment configs validated.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "../test_util.hpp"
+#include "framework/core/environment.hpp"
+#include "framework/core/error.hpp"
+#include "framework/core/registry.hpp"
+#include "framework/train/trainer.hpp"
+#include "train_fixtures.hpp"
+
+namespace skinlab {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path& tubes() {
+  static testing::TempDir dir;
+  static const fs::path file = [] {
+    const fs::path f = dir / "tubes.h5";
+    testing::write_tube_dataset(f, 4, 1, 1);
+    return f;
+  }();
+  return file;
+}
+
+// The paper's architecture with tiny widths (what configs/smoke.yaml runs in CI).
+const char* kTinyModel = R"(
+model:
+  type: heterskinnet
+  top_k: 3
+  stem:
+    - {type: b2v, mlp: [16]}
+    - {type: v2b, mlp: [8]}
+    - {type: mesh_conv, edge_mlp: [16], mlp: [16]}
+    - {type: edge_conv, edges: skeleton, mlp: [8]}
+  local:
+    - {type: b2v, mlp: [16]}
+    - {type: v2b, mlp: [8]}
+    - {type: mesh_conv, edge_mlp: [16], mlp: [16]}
+    - {type: edge_conv, edges: skeleton, mlp: [8]}
+  global: {type: global_pool, vertex_mlp: [16], bone_mlp: [16], to: [vertex], keep_input: false}
+  head: [32, 16]
+)";
+
+config::Config tiny_config(const fs::path& results) {
+  std::string text = testing::tube_config(tubes(), results);
+  text.replace(
+      text.find("model: {type: test_vertex_mlp"),
+      text.find('\n', text.find("model: {")) - text.find("model: {type: test_vertex_mlp") + 1, "");
+  config::Config c = config::Config::parse(text + kTinyModel, "tiny.yaml");
+  c.apply_override("train.lr=1.0e-3");
+  c.apply_override("train.epochs=6");
+  return c;
+}
+
+TEST(HeterSkinNet, TrainsLossDecreasesAndPredictsValidWeights) {
+  set_torch_threads(2);
+  testing::TempDir results;
+  const config::Config config = tiny_config(results.path());
+  train::Trainer trainer(config);
+  const double before = trainer.mean_loss("train");
+  const RunDir run = train::create_run(config, trainer.options(), "a", {"test"});
+  const train::TrainResult r = trainer.fit(run);
+  EXPECT_EQ(r.epochs, 6);
+  const double after = trainer.mean_loss("train");
+  EXPECT_LT(after, before) << "train loss did not decrease: " << before << " → " << after;
+
+  trainer.model().eval();
+  torch::NoGradGuard no_grad;
+  const auto& c = trainer.data().tensors(trainer.data().part("test").at(0));
+  const torch::Tensor w = trainer.model().forward(c);
+  ASSERT_EQ(w.sizes(), (std::vector<std::int64_t>{c.num_vertices(), 3}));
+  EXPECT_TRUE((w >= 0).all().item<bool>());
+  EXPECT_TRUE(torch::allclose(w.sum(1), torch::ones({c.num_vertices()}), 1e-5, 1e-5));
+  const torch::Tensor full = data::scatter_to_bones(w, c.topk_index, c.num_bones());
+  EXPECT_TRUE(((full > 0).sum(1) <= 3).all().item<bool>());
+  // Eval mode is deterministic (no edge or head dropout).
+  EXPECT_TRUE(torch::equal(w, trainer.model().forward(c)));
+}
+
+TEST(HeterSkinNet, BadOptionsAreConfigErrors) {
+  auto make = [](const std::string& yaml) {
+    return model_registry().create(config::Config::parse(yaml, "m.yaml").root());
+  };
+  EXPECT_THROW(make("type: heterskinnet\nhead_widths: [8]"), ConfigError);
+  EXPECT_THROW(make("type: heterskinnet\nhead_dropout: 1.5"), ConfigError);
+  EXPECT_THROW(make("type: heterskinnet\nlocal: [{type: edge_cnv}]"), Error);
+  EXPECT_THROW(make("type: heterskinnet\nedge_dropout: {p: 2}"), ConfigError);
+}
+
+TEST(HeterSkinNet, ShippedExperimentConfigsValidate) {
+  for (const char* file :
+       {"heterskinnet.yaml", "heterskinnet_bundled.yaml", "smoke.yaml", "ablations/euclidean.yaml",
+        "ablations/no_heterconv.yaml", "ablations/no_smoothing.yaml"}) {
+    const auto config = config::Config::load(std::string(SKINLAB_SOURCE_DIR) + "/configs/" + file);
+    const auto options = train::RunOptions::from(config);
+    EXPECT_NO_THROW(options.require_training_sections(config)) << file;
+    EXPECT_NO_THROW(model_registry().create(options.model)) << file;
+  }
+}
+
+}  // namespace
+}  // namespace skinlab
