@@ -52,10 +52,6 @@ HeterSkinNet::Options HeterSkinNet::Options::from(const config::Node& node) {
   if (!o.stem.exists()) o.stem = defaults().root()["stem"];
   if (!o.local.exists()) o.local = defaults().root()["local"];
   if (!o.global.exists()) o.global = defaults().root()["global"];
-  // Construct (unbuilt) once here so a bad op node is a ConfigError before any work starts.
-  graph::Sequence::from(o.stem);
-  graph::Sequence::from(o.local);
-  graph::graph_op_from(o.global);
   return o;
 }
 

@@ -12,6 +12,7 @@
 #include "framework/core/progress.hpp"
 #include "framework/core/registry.hpp"
 #include "framework/data/tensors.hpp"
+#include "framework/eval/evaluate.hpp"
 #include "framework/eval/metric.hpp"
 #include "framework/eval/predictions.hpp"
 #include "framework/losses/loss.hpp"
@@ -47,17 +48,10 @@ std::vector<std::string> columns(const std::vector<CharacterResult>& characters)
 }  // namespace
 
 std::map<std::string, double> mean_values(const std::vector<CharacterResult>& characters) {
-  std::map<std::string, std::pair<double, int>> sums;
-  for (const auto& c : characters) {
-    for (const auto& [name, value] : c.values) {
-      auto& [sum, n] = sums[name];
-      sum += value;
-      ++n;
-    }
-  }
-  std::map<std::string, double> out;
-  for (const auto& [name, s] : sums) out[name] = s.first / s.second;
-  return out;
+  std::vector<std::map<std::string, double>> rows;
+  rows.reserve(characters.size());
+  for (const auto& c : characters) rows.push_back(c.values);
+  return mean_over_characters(rows);
 }
 
 EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
@@ -84,9 +78,7 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
   const train::TrainingState state = train::load_checkpoint(checkpoint, *model);
   const losses::LossSum loss = losses::LossSum::from(o.losses);
   std::vector<std::shared_ptr<Metric>> metrics;
-  if (o.metrics.exists()) {
-    for (std::size_t i = 0; i < o.metrics.size(); ++i) metrics.push_back(metric_registry().create(o.metrics[i]));
-  }
+  if (o.metrics.exists() && o.metrics.size() > 0) metrics = make_metrics(o.metrics);
 
   EvalReport report;
   report.split = o.data.split;
@@ -107,7 +99,8 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
   torch::NoGradGuard no_grad;
   Progress progress("eval " + options.part, indices.size());
   for (int index : indices) {
-    const data::PreparedCharacter& character = data.dataset().characters[static_cast<std::size_t>(index)];
+    const data::PreparedCharacter& character =
+        data.dataset().characters[static_cast<std::size_t>(index)];
     const data::CharacterTensors& c = data.tensors(index);
     const torch::Tensor pred = model->forward(c);
     train::check_prediction(pred, c, o);
@@ -155,8 +148,10 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   nlohmann::json per_character = nlohmann::json::array();
   for (const auto& c : report.characters) {
-    per_character.push_back(
-        {{"character", c.name}, {"vertices", c.vertices}, {"bones", c.bones}, {"values", c.values}});
+    per_character.push_back({{"character", c.name},
+                             {"vertices", c.vertices},
+                             {"bones", c.bones},
+                             {"values", c.values}});
   }
   const nlohmann::json out = {{"experiment", o.experiment},
                               {"run", run.id()},

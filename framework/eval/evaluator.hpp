@@ -48,7 +48,8 @@ struct EvalReport {
   double seconds = 0;
 };
 
-/// The mean of each named value over the characters that report it (NaN stays NaN).
+/// The mean of each named value over the characters (eval::mean_over_characters: every character
+/// reports the same names, the loss and the configured metrics; NaN stays NaN).
 std::map<std::string, double> mean_values(const std::vector<CharacterResult>& characters);
 
 /// Evaluates `run` (see the file comment). Throws Error/IoError/ConfigError for: an unknown part

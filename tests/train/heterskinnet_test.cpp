@@ -27,34 +27,13 @@ const fs::path& tubes() {
   return file;
 }
 
-// The paper's architecture with tiny widths (what configs/smoke.yaml runs in CI).
-const char* kTinyModel = R"(
-model:
-  type: heterskinnet
-  top_k: 3
-  stem:
-    - {type: b2v, mlp: [16]}
-    - {type: v2b, mlp: [8]}
-    - {type: mesh_conv, edge_mlp: [16], mlp: [16]}
-    - {type: edge_conv, edges: skeleton, mlp: [8]}
-  local:
-    - {type: b2v, mlp: [16]}
-    - {type: v2b, mlp: [8]}
-    - {type: mesh_conv, edge_mlp: [16], mlp: [16]}
-    - {type: edge_conv, edges: skeleton, mlp: [8]}
-  global: {type: global_pool, vertex_mlp: [16], bone_mlp: [16], to: [vertex], keep_input: false}
-  head: [32, 16]
-)";
-
+// configs/smoke.yaml (the paper's architecture with tiny widths, what CI runs) on the tubes.
 config::Config tiny_config(const fs::path& results) {
-  std::string text = testing::tube_config(tubes(), results);
-  text.replace(
-      text.find("model: {type: test_vertex_mlp"),
-      text.find('\n', text.find("model: {")) - text.find("model: {type: test_vertex_mlp") + 1, "");
-  config::Config c = config::Config::parse(text + kTinyModel, "tiny.yaml");
-  c.apply_override("train.lr=1.0e-3");
-  c.apply_override("train.epochs=6");
-  return c;
+  return config::Config::load(
+      std::string(SKINLAB_SOURCE_DIR) + "/configs/smoke.yaml",
+      {"data.file=" + tubes().string(), "data.distance=euclidean",
+       "results_dir=" + results.string(), "train.lr=1.0e-3", "train.epochs=6",
+       "train.max_characters_per_epoch=0", "train.patience=0"});
 }
 
 TEST(HeterSkinNet, TrainsLossDecreasesAndPredictsValidWeights) {
