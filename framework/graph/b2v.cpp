@@ -17,8 +17,8 @@ Dims B2v::do_build(const Dims& in) {
   TORCH_CHECK(in.vertex >= 1 && in.bone >= 1, type(),
               ": needs vertex and bone features, but the input widths are vertex ", in.vertex,
               ", bone ", in.bone);
-  TORCH_CHECK(in.top_k >= 1, type(), ": needs K ≥ 1 candidate bones per vertex, got K = ",
-              in.top_k);
+  TORCH_CHECK(in.top_k >= 1, type(),
+              ": needs K ≥ 1 candidate bones per vertex, got K = ", in.top_k);
   mlp_ = register_module("mlp", Mlp(in.vertex + in.top_k * in.bone, MlpOptions{options_.mlp}));
   Dims out = in;
   out.vertex = mlp_->out_width();

@@ -41,8 +41,7 @@ Features EdgeConv::forward(const Features& in, const Graph& graph) {
   } else {
     check_features(in.vertex, graph.num_vertices, in_dims().vertex, "vertex features", type());
     check_edges(graph.edges(options_.edges), graph.num_vertices, set, "vertices", type());
-    out.vertex =
-        edge_conv_max(in.vertex, graph.edges(options_.edges), *mlp_, options_.self_loops);
+    out.vertex = edge_conv_max(in.vertex, graph.edges(options_.edges), *mlp_, options_.self_loops);
   }
   return out;
 }

@@ -14,7 +14,8 @@ EdgeDropoutOptions EdgeDropoutOptions::from(const config::Node& node) {
     for (std::size_t i = 0; i < sets.size(); ++i) {
       const EdgeSet set = parse_edge_set(sets[i]);
       for (EdgeSet seen : o.edges) {
-        if (seen == set) sets[i].fail(std::string("edge set '") + to_string(set) + "' listed twice");
+        if (seen == set)
+          sets[i].fail(std::string("edge set '") + to_string(set) + "' listed twice");
       }
       o.edges.push_back(set);
     }
@@ -49,9 +50,15 @@ Graph drop_edges(const Graph& graph, const EdgeDropoutOptions& options) {
     if (!e.defined()) continue;
     torch::Tensor kept = drop_edges(e, options.p, options.symmetric);
     switch (set) {
-      case EdgeSet::kOneRing: out.one_ring = kept; break;
-      case EdgeSet::kGeodesic: out.geodesic = kept; break;
-      case EdgeSet::kSkeleton: out.skeleton = kept; break;
+      case EdgeSet::kOneRing:
+        out.one_ring = kept;
+        break;
+      case EdgeSet::kGeodesic:
+        out.geodesic = kept;
+        break;
+      case EdgeSet::kSkeleton:
+        out.skeleton = kept;
+        break;
     }
   }
   return out;

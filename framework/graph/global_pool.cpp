@@ -68,7 +68,8 @@ Dims GlobalPool::do_build(const Dims& in) {
   for (Node node : options_.pool) {
     const bool vertex = node == Node::kVertex;
     const std::int64_t width = vertex ? in.vertex : in.bone;
-    TORCH_CHECK(width >= 1, type(), ": pools ", vertex ? "vertex" : "bone", " features, but their "
+    TORCH_CHECK(width >= 1, type(), ": pools ", vertex ? "vertex" : "bone",
+                " features, but their "
                 "input width is 0");
     Mlp& mlp = vertex ? vertex_mlp_ : bone_mlp_;
     mlp = register_module(vertex ? "vertex_mlp" : "bone_mlp",

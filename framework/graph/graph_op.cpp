@@ -6,9 +6,12 @@ namespace skinlab::graph {
 
 const char* to_string(EdgeSet set) {
   switch (set) {
-    case EdgeSet::kOneRing: return "one_ring";
-    case EdgeSet::kGeodesic: return "geodesic";
-    case EdgeSet::kSkeleton: return "skeleton";
+    case EdgeSet::kOneRing:
+      return "one_ring";
+    case EdgeSet::kGeodesic:
+      return "geodesic";
+    case EdgeSet::kSkeleton:
+      return "skeleton";
   }
   return "?";
 }
@@ -23,9 +26,12 @@ EdgeSet parse_edge_set(const config::Node& node) {
 
 const torch::Tensor& Graph::edges(EdgeSet set) const {
   switch (set) {
-    case EdgeSet::kOneRing: return one_ring;
-    case EdgeSet::kGeodesic: return geodesic;
-    case EdgeSet::kSkeleton: return skeleton;
+    case EdgeSet::kOneRing:
+      return one_ring;
+    case EdgeSet::kGeodesic:
+      return geodesic;
+    case EdgeSet::kSkeleton:
+      return skeleton;
   }
   return one_ring;
 }
@@ -50,8 +56,7 @@ torch::Tensor skeleton_edges(const torch::Tensor& bone_joints) {
   const std::int64_t nb = bone_joints.size(0);
   // share[a, b] = some joint of a equals some joint of b: (#B×1×2×1) == (1×#B×1×2), any over 2×2.
   const torch::Tensor j = bone_joints.cpu();
-  torch::Tensor share =
-      (j.view({nb, 1, 2, 1}) == j.view({1, nb, 1, 2})).flatten(2).any(2);
+  torch::Tensor share = (j.view({nb, 1, 2, 1}) == j.view({1, nb, 1, 2})).flatten(2).any(2);
   share.fill_diagonal_(false);
   return share.nonzero().contiguous();  // row-major: sorted by (a, b)
 }
@@ -111,8 +116,8 @@ void check_topk(const Graph& graph, std::int64_t k, const std::string& op) {
               graph.num_bones, " bones");
 }
 
-void check_features(const torch::Tensor& x, std::int64_t rows, std::int64_t width,
-                    const char* what, const std::string& op) {
+void check_features(const torch::Tensor& x, std::int64_t rows, std::int64_t width, const char* what,
+                    const std::string& op) {
   TORCH_CHECK(x.defined(), op, ": needs ", what, " (", rows, "×", width, "), got none");
   TORCH_CHECK(x.dim() == 2, op, ": ", what, " must be a 2-D ", rows, "×", width,
               " tensor, got shape ", x.sizes());
@@ -139,7 +144,8 @@ Dims GraphOp::build(const Dims& in) {
 }
 
 void GraphOp::check_built() const {
-  TORCH_CHECK(built_, type(), ": forward() before build(); the owning model must call build() "
+  TORCH_CHECK(built_, type(),
+              ": forward() before build(); the owning model must call build() "
               "with the input widths first");
 }
 

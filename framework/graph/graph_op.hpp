@@ -54,9 +54,10 @@
 /// Submodules are registered under stable names (`<index>_<type>` in a Sequence, `mlp`,
 /// `edge_mlp_<set>` inside an op), so checkpoint keys follow the config.
 ///
-/// Every op is written with whole-tensor gathers (`index_select`) and scatters
-/// (`scatter_reduce`, `index_add`) over the index tensors, never a loop over vertices or edges,
-/// and works in any floating dtype (float32 for training, float64 for gradient checks).
+/// Every op is written with whole-tensor gathers (`index_select`) and reductions over the index
+/// tensors (`segment_reduce` on receiver-sorted rows, `index_add`; aggregate.hpp), never a loop
+/// over vertices or edges, and works in any floating dtype (float32 for training, float64 for
+/// gradient checks). Ops are deterministic on the CPU for a given input.
 
 #include <torch/torch.h>
 
@@ -154,8 +155,8 @@ void check_edges(const torch::Tensor& edges, std::int64_t num_nodes, const char*
 /// `graph.topk_index` is #V×k int64 with entries in [0, #B); names the first bad (vertex, slot).
 void check_topk(const Graph& graph, std::int64_t k, const std::string& op);
 /// `x` is a defined `rows`×`width` floating tensor; `what` is "vertex features" or "bone features".
-void check_features(const torch::Tensor& x, std::int64_t rows, std::int64_t width,
-                    const char* what, const std::string& op);
+void check_features(const torch::Tensor& x, std::int64_t rows, std::int64_t width, const char* what,
+                    const std::string& op);
 
 // ---- the interface -----------------------------------------------------------------------------
 

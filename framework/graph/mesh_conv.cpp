@@ -18,7 +18,8 @@ MeshConv::Options MeshConv::Options::from(const config::Node& node) {
       const EdgeSet set = parse_edge_set(sets[i]);
       if (is_bone_set(set)) sets[i].fail("mesh_conv runs on vertex edge sets (one_ring, geodesic)");
       for (EdgeSet seen : o.edges) {
-        if (seen == set) sets[i].fail(std::string("edge set '") + to_string(set) + "' listed twice");
+        if (seen == set)
+          sets[i].fail(std::string("edge set '") + to_string(set) + "' listed twice");
       }
       o.edges.push_back(set);
     }

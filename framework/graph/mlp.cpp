@@ -4,11 +4,10 @@
 
 namespace skinlab::graph {
 
-void kaiming_init(const torch::nn::Linear& linear) {
+void kaiming_init(torch::nn::LinearImpl& linear) {
   torch::NoGradGuard no_grad;
-  torch::nn::init::kaiming_normal_(linear->weight, kLeakySlope, torch::kFanIn,
-                                   torch::kLeakyReLU);
-  if (linear->bias.defined()) linear->bias.zero_();
+  torch::nn::init::kaiming_normal_(linear.weight, kLeakySlope, torch::kFanIn, torch::kLeakyReLU);
+  if (linear.bias.defined()) linear.bias.zero_();
 }
 
 MlpImpl::MlpImpl(std::int64_t in_width, MlpOptions options)
@@ -20,9 +19,9 @@ MlpImpl::MlpImpl(std::int64_t in_width, MlpOptions options)
   for (std::size_t i = 0; i < options_.widths.size(); ++i) {
     TORCH_CHECK(options_.widths[i] >= 1, "mlp: layer ", i, " width must be ≥ 1, got ",
                 options_.widths[i]);
-    auto linear = register_module("linear" + std::to_string(i),
-                                  torch::nn::Linear(width, options_.widths[i]));
-    kaiming_init(linear);
+    torch::nn::Linear linear(width, options_.widths[i]);
+    register_module("linear" + std::to_string(i), linear);
+    kaiming_init(*linear);
     linears_.push_back(linear);
     width = options_.widths[i];
   }

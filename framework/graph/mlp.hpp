@@ -59,6 +59,6 @@ class MlpImpl : public torch::nn::Module {
 TORCH_MODULE(Mlp);
 
 /// Kaiming-normal weights (fan_in, LeakyReLU(0.2) gain) and zero bias, in place.
-void kaiming_init(const torch::nn::Linear& linear);
+void kaiming_init(torch::nn::LinearImpl& linear);
 
 }  // namespace skinlab::graph

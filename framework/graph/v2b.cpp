@@ -25,7 +25,8 @@ torch::Tensor pool_vertices_to_bones(const torch::Tensor& x, const torch::Tensor
   // One row per (vertex, candidate) pair: the vertex's feature, sent to the candidate bone.
   const torch::Tensor bone = topk_index.reshape({-1});
   const torch::Tensor rows = x.unsqueeze(1).expand({nv, k, f}).reshape({nv * k, f});
-  const torch::Tensor count = count_rows(bone, num_bones, x.scalar_type()).clamp_min(1).view({-1, 1});
+  const torch::Tensor count =
+      count_rows(bone, num_bones, x.scalar_type()).clamp_min(1).view({-1, 1});
   const torch::Tensor max = scatter_rows(rows, bone, num_bones, "amax");
   const torch::Tensor mean = scatter_rows(rows, bone, num_bones, "sum") / count;
   const torch::Tensor deviation = rows - mean.index_select(0, bone);
@@ -37,8 +38,8 @@ Dims V2b::do_build(const Dims& in) {
   TORCH_CHECK(in.vertex >= 1 && in.bone >= 1, type(),
               ": needs vertex and bone features, but the input widths are vertex ", in.vertex,
               ", bone ", in.bone);
-  TORCH_CHECK(in.top_k >= 1, type(), ": needs K ≥ 1 candidate bones per vertex, got K = ",
-              in.top_k);
+  TORCH_CHECK(in.top_k >= 1, type(),
+              ": needs K ≥ 1 candidate bones per vertex, got K = ", in.top_k);
   mlp_ = register_module("mlp", Mlp(in.bone + 3 * in.vertex, MlpOptions{options_.mlp}));
   Dims out = in;
   out.bone = mlp_->out_width();
@@ -50,8 +51,8 @@ Features V2b::forward(const Features& in, const Graph& graph) {
   check_features(in.vertex, graph.num_vertices, in_dims().vertex, "vertex features", type());
   check_features(in.bone, graph.num_bones, in_dims().bone, "bone features", type());
   check_topk(graph, in_dims().top_k, type());
-  const torch::Tensor pooled = pool_vertices_to_bones(in.vertex, graph.topk_index, graph.num_bones,
-                                                      options_.variance_scale);
+  const torch::Tensor pooled =
+      pool_vertices_to_bones(in.vertex, graph.topk_index, graph.num_bones, options_.variance_scale);
   Features out = in;
   out.bone = mlp_->forward(torch::cat({in.bone, pooled}, 1));
   return out;
