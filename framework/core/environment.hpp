@@ -22,7 +22,8 @@ struct GitState {
 GitState git_state(const std::filesystem::path& dir);
 
 /// Versions of the compiler and of every library that can change a result:
-/// {"compiler", "libtorch", "eigen", "cgal", "hdf5", "yaml_cpp", "fmt", "spdlog", "json"}.
+/// {"compiler", "libtorch", "eigen", "cgal", "hdf5", "yaml_cpp", "fmt", "spdlog", "json"}, and the
+/// file the BLAS libtorch calls was loaded from ("blas").
 nlohmann::json library_versions();
 
 /// Number of intra-op threads libtorch uses.
