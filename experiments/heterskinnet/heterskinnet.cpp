@@ -37,6 +37,7 @@ HeterSkinNet::Options HeterSkinNet::Options::from(const config::Node& node) {
   Options o;
   config::Fields f(node, "model heterskinnet");
   f.optional("top_k", o.top_k);
+  f.optional("distance_unit", o.distance_unit);
   f.optional("min_distance", o.min_distance);
   o.edge_dropout = graph::EdgeDropoutOptions::from(f.section("edge_dropout"));
   o.stem = f.section("stem");
@@ -45,6 +46,7 @@ HeterSkinNet::Options HeterSkinNet::Options::from(const config::Node& node) {
   f.optional("head", o.head);
   f.optional("head_dropout", o.head_dropout);
   f.check(o.top_k >= 1, "top_k", "must be ≥ 1");
+  f.check(o.distance_unit > 0, "distance_unit", "must be positive");
   f.check(o.min_distance > 0, "min_distance", "must be positive");
   for (auto w : o.head) f.check(w >= 1, "head", "widths must be ≥ 1");
   f.check(o.head_dropout >= 0 && o.head_dropout < 1, "head_dropout", "must be in [0, 1)");
@@ -88,7 +90,10 @@ torch::Tensor HeterSkinNet::forward(const data::CharacterTensors& c) {
 
   graph::Features in;
   in.vertex =
-      torch::cat({c.positions, c.topk_distance.clamp_min(options_.min_distance).reciprocal()}, 1);
+      torch::cat({c.positions, (c.topk_distance / options_.distance_unit)
+                                   .clamp_min(options_.min_distance)
+                                   .reciprocal()},
+                 1);
   in.bone = c.bones;
   const graph::Features x = stem_->forward(in, g);
   const graph::Features glob = global_->forward(x, g);

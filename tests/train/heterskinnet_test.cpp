@@ -61,12 +61,32 @@ TEST(HeterSkinNet, TrainsLossDecreasesAndPredictsValidWeights) {
   EXPECT_TRUE(torch::equal(w, trainer.model().forward(c)));
 }
 
+// The paper-width network as initialised (Kaiming normal) must start from soft predictions: with
+// 1/D in metres (up to 10³) it started with one-hot rows and the softmax never recovered.
+TEST(HeterSkinNet, PaperWidthsStartUnsaturated) {
+  set_torch_threads(2);
+  testing::TempDir results;
+  const config::Config config = config::Config::load(
+      std::string(SKINLAB_SOURCE_DIR) + "/configs/heterskinnet.yaml",
+      {"data.file=" + tubes().string(), "data.distance=euclidean",
+       "results_dir=" + results.path().string()});
+  train::Trainer trainer(config);
+  trainer.model().eval();
+  torch::NoGradGuard no_grad;
+  const auto& c = trainer.data().tensors(trainer.data().part("train").at(0));
+  const torch::Tensor top = std::get<0>(trainer.model().forward(c).max(1));
+  EXPECT_LT((top > 0.99).to(torch::kFloat).mean().item<float>(), 0.05)
+      << "most rows start one-hot; mean largest weight " << top.mean().item<float>();
+}
+
 TEST(HeterSkinNet, BadOptionsAreConfigErrors) {
   auto make = [](const std::string& yaml) {
     return model_registry().create(config::Config::parse(yaml, "m.yaml").root());
   };
   EXPECT_THROW(make("type: heterskinnet\nhead_widths: [8]"), ConfigError);
   EXPECT_THROW(make("type: heterskinnet\nhead_dropout: 1.5"), ConfigError);
+  EXPECT_THROW(make("type: heterskinnet\ndistance_unit: 0"), ConfigError);
+  EXPECT_THROW(make("type: heterskinnet\nmin_distance: -1"), ConfigError);
   EXPECT_THROW(make("type: heterskinnet\nlocal: [{type: edge_cnv}]"), Error);
   EXPECT_THROW(make("type: heterskinnet\nedge_dropout: {p: 2}"), ConfigError);
 }
