@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <array>
 #include <cstdio>
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "framework/core/atomic_file.hpp"
+#include "framework/data/h5.hpp"
 #include "tests/test_util.hpp"
 
 namespace skinlab {
@@ -207,6 +209,69 @@ TEST(Cli, TrainAndEvalReportBadInputsBeforeCreatingARun) {
   const Result o = run("train --resume " + (dir / "run").string() + " seed=3");
   EXPECT_EQ(o.status, 1);
   EXPECT_NE(o.err.find("overrides would change the run's config"), std::string::npos) << o.err;
+}
+
+// What CI runs of the main job's path: configs/smoke.yaml (HeterSkinNet with tiny widths) on the
+// bundled real 0 A.D. subset, prepared here, trained and evaluated through the binary.
+TEST(Cli, SmokeRunPrepareTrainEvalOnTheBundledSubset) {
+  TempDir dir;
+  const std::string data = (dir / "bundled.h5").string();
+  const std::string results = (dir / "results").string();
+  const Result p = run("prepare configs/datasets/zeroad_bundled.yaml output=" + data + " --threads 2");
+  ASSERT_EQ(p.status, 0) << p.err;
+
+  const Result t = run("train configs/smoke.yaml data.file=" + data + " results_dir=" + results +
+                       " --run-id ci");
+  ASSERT_EQ(t.status, 0) << t.err;
+  const std::filesystem::path run_dir = dir / "results" / "smoke" / "ci";
+  for (const char* f : {"config.yaml", "env.json", "metrics.jsonl", "best.pt", "last.pt"}) {
+    EXPECT_TRUE(std::filesystem::exists(run_dir / f)) << f;
+  }
+  // Fixed seed: the validation loss (same characters every epoch, eval mode) goes down.
+  std::ifstream lines(run_dir / "metrics.jsonl");
+  std::vector<nlohmann::json> epochs;
+  for (std::string line; std::getline(lines, line);) epochs.push_back(nlohmann::json::parse(line));
+  ASSERT_EQ(epochs.size(), 3u);
+  EXPECT_LT(epochs.back()["val_loss"].get<double>(), epochs.front()["val_loss"].get<double>());
+  EXPECT_EQ(epochs.front()["characters"].get<int>(), 4);
+
+  const Result e = run("eval " + run_dir.string() + " --split test");
+  ASSERT_EQ(e.status, 0) << e.err;
+  const auto report = nlohmann::json::parse(read_file(run_dir / "eval_test.json"));
+  const auto& m = report["mean"];
+  for (const char* key : {"precision", "recall", "avg_l1", "deformation_error"}) {
+    ASSERT_TRUE(m.contains(key)) << key << " missing in " << report.dump();
+    EXPECT_TRUE(std::isfinite(m[key].get<double>())) << key;
+  }
+  EXPECT_GT(m["precision"].get<double>(), 0.0);
+  EXPECT_LE(m["precision"].get<double>(), 1.0);
+  EXPECT_GT(m["recall"].get<double>(), 0.0);
+  EXPECT_LE(m["recall"].get<double>(), 1.0);
+
+  // Predicted weights are valid: non-negative, rows sum to 1, non-zero only on the K candidates.
+  const data::H5Reader h5(run_dir / "predictions" / "test.h5");
+  const auto names = h5.read_strings("/character_names");
+  ASSERT_FALSE(names.empty());
+  for (const auto& name : names) {
+    const std::string g = "/characters/" + name + "/";
+    const data::RowMatrixXf candidates = h5.read_float(g + "candidates");
+    const data::RowMatrixXf full = h5.read_float(g + "prepared_weights");
+    const data::RowMatrixXi topk = h5.read_int(g + "topk_index");
+    ASSERT_EQ(candidates.rows(), full.rows()) << name;
+    EXPECT_GE(full.minCoeff(), 0.0f) << name;
+    for (Eigen::Index v = 0; v < full.rows(); ++v) {
+      ASSERT_NEAR(full.row(v).sum(), 1.0f, 1e-5f) << name << " vertex " << v;
+      ASSERT_NEAR(candidates.row(v).sum(), 1.0f, 1e-5f) << name << " vertex " << v;
+      int nonzero = 0;
+      for (Eigen::Index b = 0; b < full.cols(); ++b) {
+        if (full(v, b) == 0.0f) continue;
+        ++nonzero;
+        ASSERT_TRUE((topk.row(v).array() == static_cast<int>(b)).any())
+            << name << " vertex " << v << " has weight on bone " << b << ", not a candidate";
+      }
+      ASSERT_LE(nonzero, topk.cols()) << name << " vertex " << v;
+    }
+  }
 }
 
 }  // namespace
