@@ -27,9 +27,14 @@ Registry<datasets::DatasetBuilder>& dataset_registry() {
   return registry;
 }
 
+Registry<binders::Binder>& binder_registry() {
+  static Registry<binders::Binder> registry("binder");
+  return registry;
+}
+
 std::vector<const RegistryBase*> all_registries() {
-  return {&distance_registry(), &graph_op_registry(), &model_registry(),
-          &loss_registry(),     &metric_registry(),   &dataset_registry()};
+  return {&distance_registry(), &graph_op_registry(), &model_registry(), &loss_registry(),
+          &metric_registry(),   &dataset_registry(),  &binder_registry()};
 }
 
 void verify_registries() {

@@ -129,6 +129,7 @@ namespace models { class Model; }
 namespace losses { class Loss; }
 namespace eval { class Metric; }
 namespace datasets { class DatasetBuilder; }
+namespace binders { class Binder; }
 
 /// `distance`: vertex–bone distances (Euclidean, HollowDist, volumetric geodesic).
 Registry<distances::Distance>& distance_registry();
@@ -142,6 +143,8 @@ Registry<losses::Loss>& loss_registry();
 Registry<eval::Metric>& metric_registry();
 /// `dataset`: builders turning a raw source into the HDF5 dataset.
 Registry<datasets::DatasetBuilder>& dataset_registry();
+/// `binder`: skinning weights from geometry alone, not learned (GeoVoxel, bone heat).
+Registry<binders::Binder>& binder_registry();
 
 /// Every category, in the order above.
 std::vector<const RegistryBase*> all_registries();

@@ -1,0 +1,32 @@
+#pragma once
+/// \file
+/// Interface of the `binder` registry: skinning methods that compute weights from the geometry
+/// alone, without training (HeterSkinNet Table 3's GeoVoxel, Dionne & de Lasa 2013; Blender's
+/// bone heat, Baran & Popović 2007). They are evaluated by the same pipeline and metrics as the
+/// learned models (`skinlab eval <config>` on a config with a `binder:` section), so a table row
+/// of a binder and of a network mean the same thing.
+///
+///     binder: {type: geo_voxel, resolution: 128, falloff: 0.5, max_influences: 3}
+///
+/// Implementations live in `baselines/<key>/<key>.{hpp,cpp}` and register with
+/// `SKINLAB_REGISTER(binder, <key>, Class)`.
+
+#include <Eigen/Core>
+
+#include "framework/geometry/mesh.hpp"
+#include "framework/geometry/skeleton.hpp"
+
+namespace skinlab::binders {
+
+class Binder {
+ public:
+  virtual ~Binder() = default;
+  /// #V×#B bone weights (bones in `Skeleton::bones()` order, the order of a prepared
+  /// character's `bones`): every entry ≥ 0 and every row sums to 1. The mesh is in the
+  /// normalised frame (1 m tall, Y up). Throws GeometryError naming the vertex (or bone) when a
+  /// vertex cannot be bound: never a silent zero row.
+  virtual Eigen::MatrixXd bind(const geometry::Mesh& mesh,
+                               const geometry::Skeleton& skeleton) const = 0;
+};
+
+}  // namespace skinlab::binders
