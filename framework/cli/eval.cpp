@@ -2,9 +2,14 @@
 /// `skinlab eval <run_dir> [key=value ...] [--split test] [--checkpoint best|last]`: evaluates
 /// a trained run on one part of its dataset split and writes eval_<part>.json/.csv and
 /// predictions/ into the run directory (framework/eval/evaluator.hpp).
+///
+/// `skinlab eval <config.yaml> [key=value ...] [--split test] [--run-id ID]`: a config with a
+/// `binder:` (weights from geometry alone) needs no training; this creates its run directory
+/// (resolved config, env.json) and evaluates it there.
 
 #include <fmt/format.h>
 
+#include <filesystem>
 #include <iostream>
 
 #include "framework/cli/commands.hpp"
@@ -12,7 +17,9 @@
 #include "framework/core/environment.hpp"
 #include "framework/core/run_dir.hpp"
 #include "framework/eval/evaluator.hpp"
+#include "framework/core/error.hpp"
 #include "framework/train/run_options.hpp"
+#include "framework/train/trainer.hpp"
 
 namespace skinlab::cli {
 
@@ -20,13 +27,35 @@ namespace {
 
 struct EvalArgs {
   std::string run;
+  std::string run_id;
   eval::EvalOptions options;
   bool no_predictions = false;
   int threads = -1;
 };
 
+/// The run directory of a binder config (see the file comment); the overrides are applied to the
+/// saved config, so they are cleared from `args`.
+RunDir create_binder_run(EvalArgs& args) {
+  const config::Config config = config::Config::load(args.run, args.options.overrides);
+  const train::RunOptions o = train::RunOptions::from(config);
+  if (o.model.exists()) {
+    throw Error(args.run + ": has a 'model', which must be trained first: `skinlab train " +
+                args.run + "`, then `skinlab eval <its run directory>`");
+  }
+  o.require_binder_sections(config);
+  args.options.overrides.clear();
+  RunDir run = train::create_run(config, o, args.run_id, command_line());
+  std::cout << "run: " << run.path().string() << "\n";
+  return run;
+}
+
 int run_eval(EvalArgs args) {
-  const RunDir run = RunDir::open(args.run);
+  const bool from_config = std::filesystem::is_regular_file(args.run);
+  if (!from_config && !args.run_id.empty()) {
+    throw Error("eval: --run-id names the new run of a binder config; " + args.run +
+                " is not a config file");
+  }
+  const RunDir run = from_config ? create_binder_run(args) : RunDir::open(args.run);
   if (args.threads >= 0) {
     set_torch_threads(args.threads);
   } else {
@@ -50,7 +79,11 @@ Command add_eval(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "eval", "evaluate a trained run on a split part: metrics, per-character CSV, predictions");
   auto args = std::make_shared<EvalArgs>();
-  cmd->add_option("run", args->run, "run directory (results/<experiment>/<run_id>)")->required();
+  cmd->add_option("run", args->run,
+                  "run directory (results/<experiment>/<run_id>), or the config of a binder")
+      ->required();
+  cmd->add_option("--run-id", args->run_id,
+                  "name of the new run directory of a binder config (default: the UTC time)");
   cmd->add_option("overrides", args->options.overrides,
                   "key.sub=value assignments applied to the run's config (e.g. data.file=...)");
   cmd->add_option("--split", args->options.part, "part of the configured split: train, val or test")

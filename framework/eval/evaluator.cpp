@@ -6,6 +6,7 @@
 #include <chrono>
 #include <set>
 
+#include "framework/binders/binder.hpp"
 #include "framework/core/atomic_file.hpp"
 #include "framework/core/config.hpp"
 #include "framework/core/error.hpp"
@@ -54,16 +55,72 @@ std::map<std::string, double> mean_values(const std::vector<CharacterResult>& ch
   return mean_over_characters(rows);
 }
 
+namespace {
+
+/// The prepared character's mesh and skeleton in the normalised frame, for a binder. Throws
+/// Error when the skeleton's bone order differs from the stored bones (a dataset written by
+/// another bone convention).
+std::pair<geometry::Mesh, geometry::Skeleton> geometry_of(const data::PreparedCharacter& c) {
+  geometry::Mesh mesh;
+  mesh.V = c.V;
+  mesh.F = c.F;
+  geometry::Skeleton skeleton;
+  skeleton.names = c.joint_names;
+  skeleton.positions = c.joints;
+  skeleton.parents = c.parents;
+  skeleton.validate(c.name);
+  const auto bones = skeleton.bones();
+  bool same = static_cast<Eigen::Index>(bones.size()) == c.bones.rows();
+  for (std::size_t b = 0; same && b < bones.size(); ++b) {
+    const auto i = static_cast<Eigen::Index>(b);
+    same = bones[b].start == c.bones(i, 0) && bones[b].end == c.bones(i, 1);
+  }
+  if (!same) {
+    throw Error(c.name + ": the stored bones are not in Skeleton::bones() order; re-prepare "
+                "the dataset with this build");
+  }
+  return {std::move(mesh), std::move(skeleton)};
+}
+
+/// #V×#B float32 bone weights of a binder, checked against the Binder contract.
+torch::Tensor bind_weights(const binders::Binder& binder, const std::string& type,
+                           const data::PreparedCharacter& c) {
+  const auto [mesh, skeleton] = geometry_of(c);
+  const Eigen::MatrixXd W = binder.bind(mesh, skeleton);
+  if (W.rows() != c.V.rows() || W.cols() != c.bones.rows()) {
+    throw Error(fmt::format("binder '{}' returned {}×{} weights for '{}', expected {}×{}", type,
+                            W.rows(), W.cols(), c.name, c.V.rows(), c.bones.rows()));
+  }
+  for (Eigen::Index v = 0; v < W.rows(); ++v) {
+    const double sum = W.row(v).sum();
+    if (!(W.row(v).minCoeff() >= 0) || !(std::abs(sum - 1.0) < 1e-4)) {
+      throw Error(fmt::format("binder '{}' on '{}': vertex {} has weights summing to {} (min {})",
+                              type, c.name, v, sum, W.row(v).minCoeff()));
+    }
+  }
+  const data::RowMatrixXf Wf = W.cast<float>();
+  return torch::from_blob(const_cast<float*>(Wf.data()), {Wf.rows(), Wf.cols()}, torch::kFloat32)
+      .clone();
+}
+
+}  // namespace
+
 EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  if (options.checkpoint != "best" && options.checkpoint != "last") {
-    throw Error("unknown checkpoint '" + options.checkpoint + "'; choose best or last");
-  }
   const config::Config config = config::Config::load(run.file("config.yaml"), options.overrides);
   const train::RunOptions o = train::RunOptions::from(config);
-  o.require_training_sections(config);
+  // A binder run has no checkpoint and no training loss: its weights come from the geometry.
+  const bool is_binder = o.binder.exists();
+  if (is_binder) {
+    o.require_binder_sections(config);
+  } else {
+    if (options.checkpoint != "best" && options.checkpoint != "last") {
+      throw Error("unknown checkpoint '" + options.checkpoint + "'; choose best or last");
+    }
+    o.require_training_sections(config);
+  }
   const fs::path checkpoint = run.file(options.checkpoint + ".pt");
-  if (!fs::exists(checkpoint)) {
+  if (!is_binder && !fs::exists(checkpoint)) {
     throw IoError(checkpoint.string() + ": no checkpoint '" + options.checkpoint +
                   "' in this run (a run writes best.pt and last.pt after its first epoch)");
   }
@@ -74,17 +131,28 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
     throw Error(o.data.file + ": part '" + options.part + "' of split '" + o.data.split +
                 "' has no characters");
   }
-  const auto model = train::build_model(o);
-  const train::TrainingState state = train::load_checkpoint(checkpoint, *model);
-  const losses::LossSum loss = losses::LossSum::from(o.losses);
+  std::shared_ptr<models::Model> model;
+  std::shared_ptr<binders::Binder> binder;
+  std::string method_type;
+  std::int64_t epoch = 0;
+  std::unique_ptr<losses::LossSum> loss;
+  if (is_binder) {
+    binder = binder_registry().create(o.binder);
+    method_type = o.binder["type"].as<std::string>();
+  } else {
+    model = train::build_model(o);
+    epoch = train::load_checkpoint(checkpoint, *model).epoch;
+    loss = std::make_unique<losses::LossSum>(losses::LossSum::from(o.losses));
+    model->eval();
+  }
   std::vector<std::shared_ptr<Metric>> metrics;
   if (o.metrics.exists() && o.metrics.size() > 0) metrics = make_metrics(o.metrics);
 
   EvalReport report;
   report.split = o.data.split;
   report.part = options.part;
-  report.checkpoint = options.checkpoint;
-  report.epoch = static_cast<int>(state.epoch);
+  report.checkpoint = is_binder ? "none" : options.checkpoint;
+  report.epoch = static_cast<int>(epoch);
 
   std::unique_ptr<PredictionFile> h5;
   const fs::path predictions = run.file("predictions");
@@ -95,26 +163,33 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
     h5 = std::make_unique<PredictionFile>(predictions / (options.part + ".h5"));
   }
 
-  model->eval();
   torch::NoGradGuard no_grad;
   Progress progress("eval " + options.part, indices.size());
   for (int index : indices) {
     const data::PreparedCharacter& character =
         data.dataset().characters[static_cast<std::size_t>(index)];
     const data::CharacterTensors& c = data.tensors(index);
-    const torch::Tensor pred = model->forward(c);
-    train::check_prediction(pred, c, o);
-    const torch::Tensor weights = data::scatter_to_bones(pred, c.topk_index, c.num_bones());
+    torch::Tensor candidates, weights;
+    if (is_binder) {
+      weights = bind_weights(*binder, method_type, character);
+      candidates = weights.gather(1, c.topk_index);  // the binder's weight on each candidate
+    } else {
+      candidates = model->forward(c);
+      train::check_prediction(candidates, c, o);
+      weights = data::scatter_to_bones(candidates, c.topk_index, c.num_bones());
+    }
 
     CharacterResult r;
     r.name = c.name;
     r.vertices = static_cast<int>(c.num_vertices());
     r.bones = static_cast<int>(c.num_bones());
-    losses::LossInputs in;
-    in.pred = weights;
-    in.target = data::scatter_to_bones(c.targets, c.topk_index, c.num_bones());
-    in.laplacian = c.laplacian;
-    r.values["loss"] = loss(in).item<double>();
+    if (loss) {
+      losses::LossInputs in;
+      in.pred = weights;
+      in.target = data::scatter_to_bones(c.targets, c.topk_index, c.num_bones());
+      in.laplacian = c.laplacian;
+      r.values["loss"] = (*loss)(in).item<double>();
+    }
     MetricInputs mi;
     mi.pred = weights;
     mi.target = c.bone_weights;
@@ -127,7 +202,7 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
     if (h5) {
       const data::RowMatrixXf source = to_source_vertices(to_eigen(weights), character.vertex_map);
       write_rig_prediction(rig_dir / (character.name + "_rig.txt"), character, source);
-      h5->add(character, o.data.distance, pred, weights, source);
+      h5->add(character, o.data.distance, candidates, weights, source);
     }
     progress.tick();
   }
@@ -139,8 +214,8 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
     h5->set_attribute("run", run.id());
     h5->set_attribute("split", o.data.split);
     h5->set_attribute("part", options.part);
-    h5->set_attribute("checkpoint", options.checkpoint);
-    h5->set_attribute("epoch", static_cast<std::int64_t>(state.epoch));
+    h5->set_attribute("checkpoint", report.checkpoint);
+    h5->set_attribute("epoch", epoch);
     h5->set_attribute("distance", o.data.distance);
     h5->commit();
   }
@@ -159,8 +234,11 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
                               {"split", o.data.split},
                               {"part", options.part},
                               {"distance", o.data.distance},
-                              {"checkpoint", options.checkpoint},
-                              {"epoch", state.epoch},
+                              {"method", is_binder ? "binder" : "model"},
+                              {"type", is_binder ? method_type
+                                                 : o.model["type"].as<std::string>()},
+                              {"checkpoint", report.checkpoint},
+                              {"epoch", epoch},
                               {"characters", report.characters.size()},
                               {"mean", report.mean},
                               {"per_character", per_character},

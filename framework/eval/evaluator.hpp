@@ -1,10 +1,13 @@
 #pragma once
 /// \file
-/// Evaluation of a trained run (`skinlab eval`): the model of the run's config with the
-/// parameters of one checkpoint, run on every character of one part of the configured split in
-/// eval mode without gradients; its #V×K output scattered to #V×#B bone weights
+/// Evaluation of a run (`skinlab eval`): the model of the run's config with the parameters of
+/// one checkpoint, run on every character of one part of the configured split in eval mode
+/// without gradients; its #V×K output scattered to #V×#B bone weights
 /// (data::scatter_to_bones) and compared with the full ground-truth bone weights by every metric
-/// of the config's `metrics:` list (metric.hpp), plus the training loss. Per-character values
+/// of the config's `metrics:` list (metric.hpp), plus the training loss. A run whose config has
+/// a `binder:` instead of a `model:` (binders/binder.hpp: GeoVoxel, bone heat) gets its #V×#B
+/// weights from the binder, on the same characters and with the same metrics, and has no
+/// checkpoint and no loss. Per-character values
 /// are averaged over the characters (each character counts once, the RigNet-lineage
 /// convention).
 ///

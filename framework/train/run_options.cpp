@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "framework/binders/binder.hpp"
 #include "framework/core/registry.hpp"
 #include "framework/losses/loss.hpp"
 
@@ -53,6 +54,7 @@ RunOptions RunOptions::from(const config::Config& config) {
   f.optional("results_dir", o.results_dir)
       .check(!o.results_dir.empty(), "results_dir", "must not be empty");
   o.model = f.section("model");
+  o.binder = f.section("binder");
   o.losses = f.section("losses");
   o.metrics = f.section("metrics");
   o.data_node = f.section("data");
@@ -60,6 +62,13 @@ RunOptions RunOptions::from(const config::Config& config) {
   f.finish();
 
   if (o.model.exists()) model_registry().create(o.model);
+  if (o.binder.exists()) {
+    if (o.model.exists()) {
+      o.binder.fail("a config has a 'model' (a network to train) or a 'binder' (weights from "
+                    "geometry alone), not both");
+    }
+    binder_registry().create(o.binder);
+  }
   if (o.losses.exists()) losses::LossSum::from(o.losses);
   if (o.metrics.exists()) {
     if (!o.metrics.is_sequence()) o.metrics.fail("expected a list of metrics");
@@ -70,18 +79,38 @@ RunOptions RunOptions::from(const config::Config& config) {
   return o;
 }
 
-void RunOptions::require_training_sections(const config::Config& config) const {
-  const std::pair<const config::Node*, const char*> sections[] = {
-      {&model, "model: {type: ...}"},
-      {&losses, "losses: [{type: kl, weight: 1.0}, ...]"},
-      {&data_node, "data: {file: <dataset .h5>, split: random, distance: hollow_dist}"}};
+namespace {
+
+constexpr const char* kDataExample =
+    "data: {file: <dataset .h5>, split: random, distance: hollow_dist}";
+
+void require_sections(const config::Config& config, const char* what,
+                      std::initializer_list<std::pair<const config::Node*, const char*>> sections) {
   for (const auto& [node, example] : sections) {
     if (!node->exists() || node->is_null()) {
-      throw ConfigError(config.source() + ": training needs a '" +
+      throw ConfigError(config.source() + ": " + what + " needs a '" +
                         std::string(example).substr(0, std::string(example).find(':')) +
                         "' section, e.g. " + example);
     }
   }
+}
+
+}  // namespace
+
+void RunOptions::require_training_sections(const config::Config& config) const {
+  if (binder.exists()) {
+    throw ConfigError(config.source() + ": a 'binder' is not trained; evaluate it with "
+                      "`skinlab eval " + config.source() + " --split test`");
+  }
+  require_sections(config, "training",
+                   {{&model, "model: {type: ...}"},
+                    {&losses, "losses: [{type: kl, weight: 1.0}, ...]"},
+                    {&data_node, kDataExample}});
+}
+
+void RunOptions::require_binder_sections(const config::Config& config) const {
+  require_sections(config, "evaluating a config",
+                   {{&binder, "binder: {type: geo_voxel}"}, {&data_node, kDataExample}});
 }
 
 }  // namespace skinlab::train

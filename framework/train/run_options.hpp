@@ -9,7 +9,8 @@
 ///     seed: 0                         # every random choice of the run derives from it
 ///     threads: 0                      # libtorch intra-op threads; 0 = every hardware thread
 ///     results_dir: results
-///     model: {type: ...}              # `model` registry
+///     model: {type: ...}              # `model` registry (a network, trained by `skinlab train`)
+///     binder: {type: ...}             # or: `binder` registry (not learned; `skinlab eval <config>`)
 ///     losses: [{type: kl, weight: 1}] # `loss` registry, weighted sum
 ///     metrics: [{type: ...}]          # `metric` registry
 ///     data:                           # what `skinlab train` / `skinlab eval` read
@@ -26,7 +27,8 @@
 ///       log_every: 100                # a progress line every this many steps; 0 = per epoch
 ///
 /// `data` and `train` are optional here so that `skinlab config` validates any experiment config;
-/// `skinlab train` requires `model`, `losses` and `data`.
+/// `skinlab train` requires `model`, `losses` and `data`; evaluating a binder requires `binder`
+/// and `data`. A config has a `model` or a `binder`, not both.
 
 #include <cstdint>
 #include <string>
@@ -72,6 +74,7 @@ struct RunOptions {
   int threads = 0;
   std::string results_dir = "results";
   config::Node model;    ///< missing when the config has no model section
+  config::Node binder;   ///< missing when the config has no binder section
   config::Node losses;   ///< missing when the config has no losses section
   config::Node metrics;  ///< missing when the config has no metrics section
   config::Node data_node;   ///< the `data:` section (missing when absent)
@@ -85,6 +88,8 @@ struct RunOptions {
   /// Throws ConfigError naming the config file unless the sections training and evaluation need
   /// (`model`, `losses`, `data`) are present.
   void require_training_sections(const config::Config& config) const;
+  /// Throws ConfigError naming the config file unless `binder` and `data` are present.
+  void require_binder_sections(const config::Config& config) const;
 };
 
 }  // namespace skinlab::train

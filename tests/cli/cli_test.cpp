@@ -199,6 +199,11 @@ TEST(Cli, TrainAndEvalReportBadInputsBeforeCreatingARun) {
   EXPECT_EQ(resume.status, 1);
   EXPECT_NE(resume.err.find("nowhere: run directory does not exist"), std::string::npos) << resume.err;
 
+  const Result trained_first = run("eval configs/heterskinnet.yaml");
+  EXPECT_EQ(trained_first.status, 1);
+  EXPECT_NE(trained_first.err.find("configs/heterskinnet.yaml: has a 'model', which must be "
+                                   "trained first"),
+            std::string::npos) << trained_first.err;
   const Result e = run("eval " + (dir / "nowhere").string());
   EXPECT_EQ(e.status, 1);
   EXPECT_NE(e.err.find("nowhere: run directory does not exist"), std::string::npos) << e.err;
