@@ -1,0 +1,51 @@
+/// \file
+/// `skinlab table <run_dir>... [--part test] [--format md|csv|tex] [--metrics a,b] [--title T]
+/// [--out file]`: the comparison table of saved, evaluated runs (framework/report/table.hpp);
+/// the first run is the reference of the ANOVA columns. Without --out it prints the table.
+
+#include <iostream>
+
+#include "framework/cli/commands.hpp"
+#include "framework/core/atomic_file.hpp"
+#include "framework/report/table.hpp"
+
+namespace skinlab::cli {
+
+Command add_table(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "table", "Table 3/4 from evaluated run directories: mean ± sd per metric, one-way ANOVA "
+               "of the first run against each other run");
+  struct Args {
+    std::vector<std::string> runs;
+    std::string part = "test";
+    std::string out;
+    report::TableOptions options;
+  };
+  auto args = std::make_shared<Args>();
+  cmd->add_option("runs", args->runs, "run directories; the first is the reference")->required();
+  cmd->add_option("--part", args->part, "evaluated part (eval_<part>.json)")->capture_default_str();
+  cmd->add_option("--format", args->options.format, "md, csv or tex")->capture_default_str();
+  cmd->add_option("--metrics", args->options.metrics, "metric columns, in order")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--title", args->options.title, "caption");
+  cmd->add_option("--out", args->out, "file to write (atomically); default: standard output");
+  return {cmd, [args] {
+            std::vector<report::RunResult> runs;
+            for (const auto& dir : args->runs) runs.push_back(report::load_run_result(dir, args->part));
+            std::string command;
+            for (std::size_t i = 1; i < command_line().size(); ++i) command += " " + command_line()[i];
+            command = "skinlab" + command;
+            args->options.command = command;
+            const std::string text = report::make_table(runs, args->options);
+            if (args->out.empty()) {
+              std::cout << text;
+            } else {
+              write_file_atomic(args->out, text);
+              std::cout << "wrote " << args->out << " (" << runs.size() << " runs)\n";
+            }
+            return 0;
+          }};
+}
+
+}  // namespace skinlab::cli

@@ -1,0 +1,51 @@
+#pragma once
+/// \file
+/// Result tables generated from saved run directories, never typed (HeterSkinNet Table 3: every
+/// method; Table 4: the ablations). `skinlab table <run_dir>... [--part test] [--format md|csv|tex]`
+/// reads each run's `eval_<part>.json` (framework/eval/evaluator.hpp) and writes one row per run:
+/// mean ± standard deviation over the part's characters of every metric, and a one-way ANOVA
+/// (eval/anova.hpp) of the per-character values of the reference run (the first) against each
+/// other run, per metric (Sec. 4.5, Fig. 9).
+///
+/// Every run must have been evaluated on the same characters (same dataset, split and part);
+/// otherwise the comparison would not mean anything, and it is an error naming the run and the
+/// first character that differs. The standard deviation is the sample one (n − 1).
+
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace skinlab::report {
+
+/// One evaluated run as the table sees it.
+struct RunResult {
+  std::filesystem::path dir;
+  std::string label;       ///< the run's experiment name (e.g. heterskinnet_no_smoothing)
+  std::string run_id;
+  std::string dataset, split, part;
+  std::string checkpoint;  ///< best, last, or none (a binder)
+  int epoch = 0;
+  std::vector<std::string> characters;                ///< in evaluation order
+  std::map<std::string, std::vector<double>> values;  ///< metric → per-character values
+  std::string metrics_yaml;  ///< the run config's `metrics:` section (YAML), to state thresholds
+};
+
+/// Reads `<dir>/eval_<part>.json` and the `metrics` section of `<dir>/config.yaml`. Throws
+/// IoError naming the file when it is missing (with the `skinlab eval` command that writes it)
+/// or malformed.
+RunResult load_run_result(const std::filesystem::path& dir, const std::string& part);
+
+struct TableOptions {
+  /// Metric columns, in order; default: precision, recall, avg_l1, deformation_error.
+  std::vector<std::string> metrics = {"precision", "recall", "avg_l1", "deformation_error"};
+  std::string format = "md";  ///< md, csv or tex
+  std::string title;          ///< a caption line (md: a heading; tex: \caption)
+  std::string command;        ///< the command that generated the table, quoted under it
+};
+
+/// The table text (see the file comment). Throws Error for fewer than one run, an unknown
+/// format, a metric missing from a run (naming both), or runs on different characters.
+std::string make_table(const std::vector<RunResult>& runs, const TableOptions& options);
+
+}  // namespace skinlab::report
