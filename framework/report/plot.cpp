@@ -207,4 +207,84 @@ Image histogram(const std::vector<double>& values, const HistogramOptions& o) {
   return img;
 }
 
+namespace {
+
+void draw_line(Image& img, int x0, int y0, int x1, int y1, Rgb c) {
+  const int dx = std::abs(x1 - x0), dy = -std::abs(y1 - y0);
+  const int sx = x0 < x1 ? 1 : -1, sy = y0 < y1 ? 1 : -1;
+  for (int err = dx + dy;;) {  // Bresenham, 2 px thick
+    img.fill_rect(x0, y0, x0 + 1, y0 + 1, c);
+    if (x0 == x1 && y0 == y1) break;
+    const int e2 = 2 * err;
+    if (e2 >= dy) err += dy, x0 += sx;
+    if (e2 <= dx) err += dx, y0 += sy;
+  }
+}
+
+}  // namespace
+
+Image line_plot(const std::vector<Series>& series, const LinePlotOptions& o) {
+  double x_lo = INFINITY, x_hi = -INFINITY, y_lo = INFINITY, y_hi = -INFINITY;
+  for (const auto& s : series) {
+    if (s.x.size() != s.y.size()) throw std::invalid_argument("line_plot: x and y differ in size");
+    for (std::size_t i = 0; i < s.x.size(); ++i) {
+      if (!std::isfinite(s.y[i]) || !std::isfinite(s.x[i])) continue;
+      x_lo = std::min(x_lo, s.x[i]), x_hi = std::max(x_hi, s.x[i]);
+      y_lo = std::min(y_lo, s.y[i]), y_hi = std::max(y_hi, s.y[i]);
+    }
+  }
+  if (!std::isfinite(x_lo)) throw std::invalid_argument("line_plot: no finite point");
+  const double pad = std::max(y_hi - y_lo, std::abs(y_hi) * 1e-3 + 1e-12) * 0.05;
+  const double y_step = nice_width(y_hi - y_lo + 2 * pad, 5);
+  y_lo = std::floor((y_lo - pad) / y_step) * y_step;
+  y_hi = std::ceil((y_hi + pad) / y_step) * y_step;
+  if (x_hi == x_lo) x_hi = x_lo + 1;
+  const double x_step = nice_width(x_hi - x_lo, 8);
+
+  const int scale = 2, glyph_h = 5 * scale;
+  const Rgb ink = {40, 40, 40}, grid = {225, 225, 225};
+  Image img(o.width, o.height);
+  int label_w = 0;
+  for (double v = y_lo; v <= y_hi + y_step / 2; v += y_step)
+    label_w = std::max(label_w, Image::text_width(label(std::round(v / y_step) * y_step), scale));
+  const int left = 12 + label_w, right = o.width - 16;
+  const int bottom = o.height - 14 - glyph_h, top = 12;
+  auto px = [&](double x) {
+    return left + static_cast<int>(std::lround((x - x_lo) / (x_hi - x_lo) * (right - left)));
+  };
+  auto py = [&](double y) {
+    return bottom - static_cast<int>(std::lround((y - y_lo) / (y_hi - y_lo) * (bottom - top)));
+  };
+  for (double v = y_lo; v <= y_hi + y_step / 2; v += y_step) {
+    const double tick = std::round(v / y_step) * y_step;
+    img.fill_rect(left, py(tick), right, py(tick), grid);
+    const std::string t = label(tick);
+    img.text(left - 6 - Image::text_width(t, scale), py(tick) - glyph_h / 2, t, scale, ink);
+  }
+  for (double v = std::ceil(x_lo / x_step) * x_step; v <= x_hi + x_step / 2; v += x_step) {
+    const int x = px(v);
+    img.fill_rect(x, bottom, x, bottom + 3, ink);
+    const std::string t = label(v);
+    const int tw = Image::text_width(t, scale);
+    img.text(std::min(x - tw / 2, o.width - tw - 1), bottom + 6, t, scale, ink);
+  }
+  img.fill_rect(left, bottom, right, bottom, ink);
+  img.fill_rect(left, top, left, bottom, ink);
+  for (const auto& s : series) {
+    bool have = false;
+    int last_x = 0, last_y = 0;
+    for (std::size_t i = 0; i < s.x.size(); ++i) {
+      if (!std::isfinite(s.y[i]) || !std::isfinite(s.x[i])) {
+        have = false;
+        continue;
+      }
+      const int x = px(s.x[i]), y = py(s.y[i]);
+      if (have) draw_line(img, last_x, last_y, x, y, s.colour);
+      else img.fill_rect(x - 1, y - 1, x + 1, y + 1, s.colour);
+      have = true, last_x = x, last_y = y;
+    }
+  }
+  return img;
+}
+
 }  // namespace skinlab::report

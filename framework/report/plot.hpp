@@ -46,4 +46,20 @@ struct HistogramOptions {
 /// below the minimum; y ticks are counts, x ticks bin edges. Requires at least one value.
 Image histogram(const std::vector<double>& values, const HistogramOptions& options = {});
 
+/// One curve of a line plot: points (x[i], y[i]) joined in order; non-finite y values break
+/// the line (e.g. epochs without a validation loss).
+struct Series {
+  std::vector<double> x, y;
+  Rgb colour = {70, 110, 170};
+};
+
+struct LinePlotOptions {
+  int width = 640, height = 320;
+};
+
+/// Line plot of every series on shared axes from the data's ranges (y from the smallest to the
+/// largest finite value, padded 5 %); y ticks and x ticks at "nice" steps. Requires at least
+/// one finite point.
+Image line_plot(const std::vector<Series>& series, const LinePlotOptions& options = {});
+
 }  // namespace skinlab::report

@@ -82,6 +82,35 @@ TEST(Histogram, BarHeightsFollowTheCounts) {
   EXPECT_THROW(text.text(0, 0, "x", 1, {0, 0, 0}), std::invalid_argument);
 }
 
+TEST(LinePlot, CurvesFollowTheirValuesAndGapsBreakThem) {
+  // A falling series and a rising one, each over x = 0..10; the second has a gap at x = 5.
+  Series down{{}, {}, {200, 0, 0}}, up{{}, {}, {0, 0, 200}};
+  for (int i = 0; i <= 10; ++i) {
+    down.x.push_back(i), down.y.push_back(10 - i);
+    up.x.push_back(i), up.y.push_back(i == 5 ? NAN : i);
+  }
+  const Image img = line_plot({down, up});
+  auto rows_of = [&](Rgb c, int x) {  // topmost row of colour c in column x, or -1
+    for (int y = 0; y < img.height; ++y) {
+      const auto* p = &img.pixels[(static_cast<std::size_t>(y) * img.width + x) * 3];
+      if (p[0] == c[0] && p[1] == c[1] && p[2] == c[2]) return y;
+    }
+    return -1;
+  };
+  int left_x = 0;  // the first column where the falling curve appears
+  while (rows_of(down.colour, left_x) < 0) ++left_x;
+  const int right_x = img.width - 17;
+  ASSERT_GT(rows_of(down.colour, right_x), 0);
+  EXPECT_LT(rows_of(down.colour, left_x + 2), rows_of(down.colour, right_x)) << "falls";
+  EXPECT_GT(rows_of(up.colour, left_x + 2), rows_of(up.colour, right_x)) << "rises";
+  // No blue between x = 4 and x = 6 (the gap), blue again right after x = 6.
+  const double per_unit = (right_x - left_x) / 10.0;
+  EXPECT_EQ(rows_of(up.colour, left_x + static_cast<int>(5 * per_unit)), -1);
+  EXPECT_GT(rows_of(up.colour, left_x + static_cast<int>(6.5 * per_unit)), 0);
+  EXPECT_THROW(line_plot({Series{{1}, {NAN}}}), std::invalid_argument);
+  EXPECT_THROW(line_plot({Series{{1, 2}, {1}}}), std::invalid_argument);
+}
+
 TEST(DatasetCard, ReportsCountsSplitsExclusionsAndLicences) {
   data::Dataset d;
   d.characters = {testing::tiny_character("a"), testing::tiny_character("b"),
