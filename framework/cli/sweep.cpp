@@ -1,0 +1,169 @@
+/// \file
+/// `skinlab sweep <sweep.yaml> [--threads N]`: trains (or, for binders, runs) and evaluates
+/// every entry of a sweep, then writes their table (framework/report/table.hpp). This is how
+/// Table 3 (`configs/sweeps/table3.yaml`) and Table 4 (`configs/sweeps/table4.yaml`) are made.
+///
+///     name: table4                      # every entry's run id: <results_dir>/<experiment>/<name>
+///     title: "Table 4: ablations"       # the table's caption
+///     part: test                        # evaluated part (default test)
+///     overrides: [data.file=...]        # applied to every entry, before its own
+///     predictions: false                # write predictions/ for every run (default false)
+///     metrics: [precision, recall, avg_l1, deformation_error]  # table columns
+///     out: results/tables/table4.md     # the table (Markdown); table4.csv is written beside it
+///     runs:                             # the first is the reference of the ANOVA columns
+///       - configs/heterskinnet.yaml
+///       - {config: configs/ablations/euclidean.yaml, overrides: [seed=1]}
+///
+/// A sweep can be interrupted and run again: an entry whose run directory exists continues
+/// (training resumes from last.pt; a finished run is only re-evaluated if its evaluation is
+/// missing), provided the resolved config is unchanged; a changed config is an error naming
+/// the run, so results are never mixed.
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <filesystem>
+#include <iostream>
+#include <optional>
+
+#include "framework/cli/commands.hpp"
+#include "framework/core/atomic_file.hpp"
+#include "framework/core/config.hpp"
+#include "framework/core/environment.hpp"
+#include "framework/core/error.hpp"
+#include "framework/core/run_dir.hpp"
+#include "framework/eval/evaluator.hpp"
+#include "framework/report/table.hpp"
+#include "framework/train/run_options.hpp"
+#include "framework/train/trainer.hpp"
+
+namespace skinlab::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Entry {
+  std::string config;
+  std::vector<std::string> overrides;
+};
+
+struct Sweep {
+  std::string name, title, part = "test", out;
+  std::vector<std::string> overrides;
+  std::vector<std::string> metrics = report::TableOptions{}.metrics;
+  bool predictions = false;
+  std::vector<Entry> runs;
+
+  static Sweep from(const config::Config& file) {
+    Sweep s;
+    config::Fields f(file.root(), "the sweep", {});
+    f.required("name", s.name).check(!s.name.empty(), "name", "must not be empty");
+    f.optional("title", s.title);
+    f.optional("part", s.part);
+    f.required("out", s.out);
+    f.optional("overrides", s.overrides);
+    f.optional("metrics", s.metrics);
+    f.optional("predictions", s.predictions);
+    const config::Node runs = f.section("runs");
+    f.finish();
+    if (!runs.is_sequence() || runs.size() == 0) runs.fail("expected a non-empty list of runs");
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+      Entry e;
+      if (runs[i].is_scalar()) {
+        e.config = runs[i].as<std::string>();
+      } else {
+        config::Fields r(runs[i], "a sweep entry", {});
+        r.required("config", e.config);
+        r.optional("overrides", e.overrides);
+        r.finish();
+      }
+      s.runs.push_back(std::move(e));
+    }
+    return s;
+  }
+};
+
+/// Trains or opens the run of one entry and evaluates it; returns its run directory.
+fs::path run_entry(const Sweep& sweep, const Entry& entry, int threads) {
+  std::vector<std::string> overrides = sweep.overrides;
+  overrides.insert(overrides.end(), entry.overrides.begin(), entry.overrides.end());
+  const config::Config config = config::Config::load(entry.config, overrides);
+  const train::RunOptions o = train::RunOptions::from(config);
+  const bool binder = o.binder.exists();
+  if (binder) o.require_binder_sections(config);
+  else o.require_training_sections(config);
+  set_torch_threads(threads >= 0 ? threads : o.threads);
+
+  const fs::path dir = fs::path(o.results_dir) / o.experiment / sweep.name;
+  const bool existed = fs::exists(dir);
+  if (existed) {
+    const std::string saved = read_file(dir / "config.yaml");
+    if (saved != config.to_yaml()) {
+      throw Error(dir.string() + ": exists with another config than " + entry.config +
+                  " resolves to now; move it away or rename the sweep");
+    }
+  }
+  std::cout << fmt::format("== {} ({}) → {}\n", entry.config, binder ? "binder" : "train",
+                           dir.string());
+  std::optional<RunDir> run;
+  if (!binder) {
+    train::Trainer trainer(config);
+    run = existed ? RunDir::open(dir) : train::create_run(config, o, sweep.name, command_line());
+    const train::TrainResult r = trainer.fit(*run);
+    spdlog::info("{}: {} epochs, best epoch {} (validation loss {:.6g})", o.experiment, r.epochs,
+                 r.best_epoch, r.best_loss);
+  } else {
+    run = existed ? RunDir::open(dir) : train::create_run(config, o, sweep.name, command_line());
+  }
+  eval::EvalOptions e;
+  e.part = sweep.part;
+  e.predictions = sweep.predictions;
+  const eval::EvalReport report = eval::evaluate(*run, e);
+  std::cout << fmt::format("   {} characters, {:.1f} s\n", report.characters.size(), report.seconds);
+  return run->path();
+}
+
+}  // namespace
+
+Command add_sweep(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "sweep", "train/run and evaluate every entry of a sweep file, then write their table");
+  struct Args {
+    std::string file;
+    int threads = -1;
+  };
+  auto args = std::make_shared<Args>();
+  cmd->add_option("file", args->file, "sweep file (YAML), e.g. configs/sweeps/table4.yaml")
+      ->required();
+  cmd->add_option("--threads", args->threads,
+                  "libtorch threads for every entry (default: each config's `threads`)");
+  return {cmd, [args] {
+            const Sweep sweep = Sweep::from(config::Config::load(args->file));
+            // Every entry's config must load before anything trains.
+            for (const auto& entry : sweep.runs) {
+              std::vector<std::string> overrides = sweep.overrides;
+              overrides.insert(overrides.end(), entry.overrides.begin(), entry.overrides.end());
+              train::RunOptions::from(config::Config::load(entry.config, overrides));
+            }
+            std::vector<report::RunResult> results;
+            for (const auto& entry : sweep.runs) {
+              results.push_back(report::load_run_result(run_entry(sweep, entry, args->threads),
+                                                        sweep.part));
+            }
+            report::TableOptions t;
+            t.metrics = sweep.metrics;
+            t.title = sweep.title;
+            t.command = "skinlab sweep " + args->file;
+            const std::string md = report::make_table(results, t);
+            t.format = "csv";
+            const fs::path out = sweep.out;
+            if (out.has_parent_path()) fs::create_directories(out.parent_path());
+            write_file_atomic(out, md);
+            write_file_atomic(fs::path(out).replace_extension(".csv"), report::make_table(results, t));
+            std::cout << md << "wrote " << out.string() << "\n";
+            return 0;
+          }};
+}
+
+}  // namespace skinlab::cli
