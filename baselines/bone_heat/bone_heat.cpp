@@ -6,6 +6,7 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <tbb/parallel_for.h>
 
+#include <Eigen/Geometry>
 #include <Eigen/Sparse>
 #include <algorithm>
 #include <cmath>
