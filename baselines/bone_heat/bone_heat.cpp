@@ -19,6 +19,7 @@
 
 #include "framework/core/registry.hpp"
 #include "framework/geometry/closest_point_on_segment.hpp"
+#include "framework/geometry/orient_outward.hpp"
 
 namespace skinlab::baselines {
 
@@ -69,6 +70,7 @@ BoneHeat::Options BoneHeat::Options::from(const config::Node& node) {
       .check(o.closest == "visible" || o.closest == "blender", "closest",
              "must be 'visible' or 'blender', got '" + o.closest + "'");
   f.optional("normal_weighted_distance", o.normal_weighted_distance);
+  f.optional("orient_outward", o.orient_outward);
   f.optional("weight_limit_start", o.weight_limit_start)
       .check(std::isfinite(o.weight_limit_start) && o.weight_limit_start >= 0 &&
                  o.weight_limit_start <= 1,
@@ -82,13 +84,17 @@ BoneHeat::Options BoneHeat::Options::from(const config::Node& node) {
   return o;
 }
 
-Eigen::MatrixXd BoneHeat::bind(const geometry::Mesh& mesh, const geometry::Skeleton& skeleton,
+Eigen::MatrixXd BoneHeat::bind(const geometry::Mesh& input, const geometry::Skeleton& skeleton,
                                BoneHeatStats* stats) const {
-  mesh.validate(kOwner);
+  input.validate(kOwner);
   skeleton.validate(kOwner);
   BoneHeatStats local_stats;
   BoneHeatStats& st = stats ? *stats : local_stats;
   st = {};
+  geometry::OrientReport orient;
+  const geometry::Mesh mesh =
+      options_.orient_outward ? geometry::orient_outward(input, &orient) : input;
+  st.flipped_parts = orient.flipped_parts;
   const auto bones = skeleton.bones();
   const int nv = mesh.num_vertices();
   const int nb = static_cast<int>(bones.size());

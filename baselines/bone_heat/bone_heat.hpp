@@ -6,6 +6,9 @@
 ///
 ///     (−Δ + H) w_i = H p_i
 ///
+/// - Orientation (`orient_outward`, on by default): the faces of every connected part wound
+///   inwards are flipped first (geometry/orient_outward.hpp); the normal-weighted distance and
+///   the front-face visibility below assume outward normals.
 /// - Δ: the cotangent Laplacian with vertex-area normalisation, assembled as Blender's
 ///   source/blender/editors/armature/meshlaplacian.cc does (`laplacian_triangle_area`,
 ///   `laplacian_triangle_weights`): edge weight t_jk = Σ over the triangles of edge jk of the
@@ -77,6 +80,7 @@ struct BoneHeatStats {
   int fallback_components = 0;  ///< components bound by the Euclidean fallback
   int fallback_vertices = 0;    ///< their vertices, plus zero-area vertices without a visible bone
   int limited_rows = 0;         ///< rows emptied by the weight limit (kept unlimited)
+  int flipped_parts = 0;        ///< connected parts re-oriented outwards
 };
 
 class BoneHeat final : public binders::Binder {
@@ -85,6 +89,10 @@ class BoneHeat final : public binders::Binder {
     double heat_constant = 1.0;           ///< c (Pinocchio; Blender C_WEIGHT), > 0
     std::string closest = "visible";      ///< "visible" or "blender" (see the file comment)
     bool normal_weighted_distance = true;  ///< Blender's heat_source_distance; false: Euclidean
+    /// Flip the faces of parts wound inwards first (geometry/orient_outward.hpp): the distance
+    /// and the visibility test read front and back from the winding. Blender works with the
+    /// normals it is given; the prepared game characters are all wound inwards.
+    bool orient_outward = true;
     double weight_limit_start = 0.05;     ///< Blender WEIGHT_LIMIT_START
     double weight_limit_end = 0.025;      ///< Blender WEIGHT_LIMIT_END; 0 ≤ end < start ≤ 1
     static Options from(const config::Node& node);

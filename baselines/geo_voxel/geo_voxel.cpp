@@ -15,6 +15,7 @@
 
 #include "framework/core/registry.hpp"
 #include "framework/geometry/closest_point_on_segment.hpp"
+#include "framework/geometry/orient_outward.hpp"
 
 namespace skinlab::baselines {
 
@@ -176,21 +177,26 @@ GeoVoxel::Options GeoVoxel::Options::from(const config::Node& node) {
              "must be in [0, 1]");
   f.optional("max_influences", o.max_influences)
       .check(o.max_influences >= 1, "max_influences", "must be at least 1");
+  f.optional("orient_outward", o.orient_outward);
   f.finish();
   return o;
 }
 
-Eigen::MatrixXd GeoVoxel::distances(const geometry::Mesh& mesh,
+Eigen::MatrixXd GeoVoxel::distances(const geometry::Mesh& input,
                                     const geometry::Skeleton& skeleton,
                                     GeoVoxelStats* stats) const {
-  mesh.validate(kOwner);
+  input.validate(kOwner);
   skeleton.validate(kOwner);
+  geometry::OrientReport orient;
+  const geometry::Mesh mesh =
+      options_.orient_outward ? geometry::orient_outward(input, &orient) : input;
   const auto bones = skeleton.bones();
   const int nv = mesh.num_vertices();
   const int nb = static_cast<int>(bones.size());
   GeoVoxelStats local_stats;
   GeoVoxelStats& st = stats ? *stats : local_stats;
   st = {};
+  st.flipped_parts = orient.flipped_parts;
 
   const auto surface = geometry::SurfaceVoxels::voxelize(
       mesh, geometry::VoxelGrid::fit(mesh, skeleton, options_.resolution, kMarginCells));
@@ -280,9 +286,9 @@ Eigen::MatrixXd GeoVoxel::distances(const geometry::Mesh& mesh,
   return D;
 }
 
-Eigen::MatrixXd GeoVoxel::bind(const geometry::Mesh& mesh,
-                               const geometry::Skeleton& skeleton) const {
-  const Eigen::MatrixXd D = distances(mesh, skeleton);
+Eigen::MatrixXd GeoVoxel::bind(const geometry::Mesh& mesh, const geometry::Skeleton& skeleton,
+                               GeoVoxelStats* stats) const {
+  const Eigen::MatrixXd D = distances(mesh, skeleton, stats);
   const int nv = static_cast<int>(D.rows()), nb = static_cast<int>(D.cols());
   Eigen::Vector3d lo = mesh.V.colwise().minCoeff(), hi = mesh.V.colwise().maxCoeff();
   lo = lo.cwiseMin(skeleton.positions.colwise().minCoeff().transpose());

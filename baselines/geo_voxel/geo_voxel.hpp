@@ -9,6 +9,9 @@
 ///
 /// Stages (all in the mesh's normalised frame, metres):
 ///
+/// 0. Orientation (`orient_outward`, on by default): the faces of every connected part wound
+///    inwards are flipped (geometry/orient_outward.hpp), since stage 2 reads inside from the
+///    winding and Maya requires outward-facing normals.
 /// 1. Grid. `geometry::VoxelGrid::fit` with R = `resolution` cells along the longest axis of the
 ///    bounding box of vertices and joints and a margin of 1 empty cell (+½) around it, so the
 ///    character spans R − 3 cells (125 at R = 128). Maya's resolution is "the maximum voxel grid
@@ -86,6 +89,7 @@ struct GeoVoxelStats {
   int boundary_voxels = 0;
   int snapped_bones = 0;        ///< bones seeded at their nearest solid voxel (stage 3)
   int euclidean_vertices = 0;   ///< vertices no bone reaches (stage 4 fallback)
+  int flipped_parts = 0;        ///< connected parts re-oriented outwards (stage 0)
 };
 
 class GeoVoxel final : public binders::Binder {
@@ -98,6 +102,10 @@ class GeoVoxel final : public binders::Binder {
     double falloff = 0.5;
     /// Bones kept per vertex, ≥ 1 (HeterSkinNet: 3).
     int max_influences = 3;
+    /// Flip the faces of parts wound inwards first (geometry/orient_outward.hpp). Maya requires
+    /// outward normals from the user; the prepared game characters are all wound inwards, so
+    /// without this the interior test inverts (interior cells become exterior and vice versa).
+    bool orient_outward = true;
     static Options from(const config::Node& node);
   };
 
@@ -105,7 +113,12 @@ class GeoVoxel final : public binders::Binder {
 
   /// #V×#B weights (see binder.hpp): at most `max_influences` non-zeros per row, rows sum to 1.
   Eigen::MatrixXd bind(const geometry::Mesh& mesh,
-                       const geometry::Skeleton& skeleton) const override;
+                       const geometry::Skeleton& skeleton) const override {
+    return bind(mesh, skeleton, nullptr);
+  }
+  /// As above; fills `stats` when it is not null.
+  Eigen::MatrixXd bind(const geometry::Mesh& mesh, const geometry::Skeleton& skeleton,
+                       GeoVoxelStats* stats) const;
 
   /// #V×#B distances d(v, b) of stage 4 in metres; +∞ where bone b does not reach vertex v
   /// (but another bone does). Validates mesh and skeleton (GeometryError).

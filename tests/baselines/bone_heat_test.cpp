@@ -63,6 +63,19 @@ TEST(BoneHeat, MirrorSymmetricInputGivesMirrorSymmetricWeights) {
   }
 }
 
+// Wound inwards (as every prepared game character is), the mesh is re-oriented first: same
+// weights.
+TEST(BoneHeat, InwardWindingIsReorientedFirst) {
+  const Chain c = testing::chain();
+  Chain flipped = c;
+  flipped.mesh.F.col(1).swap(flipped.mesh.F.col(2));
+  BoneHeatStats stats;
+  const Eigen::MatrixXd W = BoneHeat({}).bind(c.mesh, c.skeleton);
+  const Eigen::MatrixXd Wf = BoneHeat({}).bind(flipped.mesh, flipped.skeleton, &stats);
+  EXPECT_EQ(stats.flipped_parts, 1);
+  EXPECT_LT((W - Wf).cwiseAbs().maxCoeff(), 1e-9);
+}
+
 // Finger B's bone is nearer to finger A's inner vertex in a straight line, but the segment to it
 // enters finger B through its front side, so it is not visible: A's bone is the heat source.
 TEST(BoneHeat, HiddenNearerBoneIsNotTheSource) {

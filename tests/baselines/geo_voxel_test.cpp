@@ -120,6 +120,27 @@ TEST(GeoVoxel, MirrorSymmetricInputGivesMirrorSymmetricWeights) {
   }
 }
 
+// Wound inwards (as every prepared game character is), the mesh is re-oriented first: same
+// weights. Without re-orientation the interior test inverts.
+TEST(GeoVoxel, InwardWindingIsReorientedFirst) {
+  const Chain c = testing::chain();
+  Chain flipped = c;
+  flipped.mesh.F.col(1).swap(flipped.mesh.F.col(2));
+  GeoVoxelStats stats;
+  const Eigen::MatrixXd W = GeoVoxel({}).bind(c.mesh, c.skeleton);
+  const Eigen::MatrixXd Wf = GeoVoxel({}).bind(flipped.mesh, flipped.skeleton, &stats);
+  EXPECT_EQ(stats.flipped_parts, 1);
+  EXPECT_LT((W - Wf).cwiseAbs().maxCoeff(), 1e-12);
+  GeoVoxel::Options raw;
+  raw.orient_outward = false;
+  GeoVoxel(raw).distances(flipped.mesh, flipped.skeleton, &stats);
+  EXPECT_EQ(stats.flipped_parts, 0);
+  const auto surface = geometry::SurfaceVoxels::voxelize(
+      flipped.mesh, geometry::VoxelGrid::fit(flipped.mesh, flipped.skeleton, 64, 1));
+  const auto state = baselines::solid_voxels(flipped.mesh, surface);
+  EXPECT_EQ(state[surface.grid().cell_of({0, 0.5, 0})], VoxelState::kExterior);
+}
+
 // Finger A's inner vertex is 7 cm from B's bone and 8 cm from A's in a straight line, but the
 // path through the solid to B's bone runs down A, across the palm and up B.
 TEST(GeoVoxel, GeodesicNotEuclidean) {
