@@ -17,7 +17,8 @@
 ///   boundary edge cot α); vertex area a_j = Blender's `varea`: per non-obtuse triangle
 ///   ¼ Σ cot·|edge|² over the two edges at j, per obtuse triangle the full area at the obtuse
 ///   corner and half of it at the others (twice the mixed Voronoi area of Meyer et al. 2003);
-///   row j of −Δ is (0.5 / a_j) Σ_k t_jk (w_j − w_k). We solve the equivalent symmetric system
+///   row j of −Δ is (0.5 / a_j) Σ_k t_jk (w_j − w_k): on a manifold mesh ¼ of the textbook
+///   (1 / 2A_j) Σ_k (cot α + cot β)(w_j − w_k), so Blender's c = 1 is c = 4 with that Δ. We solve the equivalent symmetric system
 ///   (L + 2 diag(a) H) w_i = 2 diag(a) H p_i, L_jk = −t_jk, L_jj = Σ_k t_jk, with
 ///   Eigen::SimplicialLDLT (L is not an M-matrix with obtuse triangles, so LDLT, not LLT).
 ///   Triangles whose doubled area is ≤ 1e-10 × their longest squared edge (cotangent above
@@ -49,6 +50,10 @@
 ///   Blender stores these in vertex groups and normalises at deform time; we renormalise rows.
 ///   A row that the limit empties (only possible with > 20 bones sharing a vertex) keeps its
 ///   unlimited non-negative weights.
+///
+/// Helper bones (zero-length, at leaf joints) are point sources like any other bone; Blender has
+/// no such bones (its leaf bone ends at the same point, so beyond a limb's tip the two tie and
+/// share the heat).
 ///
 /// Not reproduced: Blender's X-mirror option, B-Bone segments and selected-bones-only binding.
 ///
