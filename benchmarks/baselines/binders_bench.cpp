@@ -252,4 +252,14 @@ BENCHMARK_CAPTURE(BM_Dataset, bone_heat, std::string("{type: bone_heat}"))
 
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  const char* dataset = std::getenv("SKINLAB_BINDERS_DATASET");
+  const char* split = std::getenv("SKINLAB_BINDERS_SPLIT");
+  benchmark::AddCustomContext("binders_dataset", dataset ? dataset : "(unset: BM_Dataset skipped)");
+  benchmark::AddCustomContext("binders_split",
+                              split ? std::string(split) + " (test characters)" : "(all)");
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
