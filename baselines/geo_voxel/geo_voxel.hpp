@@ -57,7 +57,10 @@
 ///    L = the longest side of the bounding box of vertices and joints. The paper normalises
 ///    distances "using a bounding box so they are independent of mesh scale" without saying which
 ///    measure of the box; the longest side is our assumption (for our 1 m characters L ≈ 1 m;
-///    the arm span when it exceeds the height). d̂ is clamped at 1e-9 so that a vertex lying on
+///    the arm span when it exceeds the height). How much this choice matters: on the 18 test
+///    characters of the games dataset, avg L1 after pruning is 0.915 with it and 0.855 with
+///    distances in voxels (L = side of a cell), against 1.218 for uniform weights over the 3
+///    nearest bones. d̂ is clamped at 1e-9 so that a vertex lying on
 ///    a bone has a finite weight. The `max_influences` bones with the largest w (smallest d,
 ///    ties: lower bone index) are kept and the row is renormalised (Maya's maxInfluences).
 ///

@@ -4,8 +4,10 @@
 /// outside from the winding (normals by the right-hand rule on F's vertex order): Geodesic Voxel
 /// Binding's interior test and Maya's requirement of outward-facing normals, Blender bone heat's
 /// normal-weighted distance and front-face visibility. Game meshes are not consistent about it:
-/// every one of the 18 test characters of configs/datasets/games.yaml (0 A.D. and Cube 2) comes
-/// out of preparation wound clockwise seen from outside (negative signed volume).
+/// all 88 characters of the dataset prepared from configs/datasets/games.yaml come out of
+/// preparation wound clockwise seen from outside (negative signed volume; measured by
+/// benchmarks/baselines/binders_bench.cpp, counter inward_characters), the Minetest player
+/// (B3D) counter-clockwise.
 ///
 /// Rule: the faces are split into connected parts (faces sharing a vertex). A part's signed
 /// volume V = Σ_f (a − c)·((b − c) × (d − c)) / 6 over its faces (a, b, d), with c the mean of
