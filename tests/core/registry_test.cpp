@@ -108,7 +108,7 @@ TEST(Registry, ExactKeysOfEveryCategory) {
       {"loss", {"kl", "laplacian_smoothing", "mse", "soft_cross_entropy"}},
       {"metric", {"avg_l1", "deformation_error", "precision_recall"}},
       {"dataset", {"cube2", "folder", "nexuiz", "zeroad"}},
-      {"binder", {}},
+      {"binder", {"bone_heat", "geo_voxel"}},
   };
   EXPECT_EQ(actual, expected);
 }
