@@ -12,7 +12,10 @@
 ///     out: results/tables/table4.md     # the table (Markdown); table4.csv is written beside it
 ///     runs:                             # the first is the reference of the ANOVA columns
 ///       - configs/heterskinnet.yaml
-///       - {config: configs/ablations/euclidean.yaml, overrides: [seed=1]}
+///       - {config: configs/ablations/euclidean.yaml, overrides: [seed=1], run_id: table4-seed1}
+///
+/// An entry's run id is the sweep's name unless it sets `run_id`; two entries that would share a
+/// run directory (same experiment and run id) are an error.
 ///
 /// A sweep can be interrupted and run again: an entry whose run directory exists continues
 /// (training resumes from last.pt; a finished run is only re-evaluated if its evaluation is
@@ -24,6 +27,7 @@
 
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <optional>
 
 #include "framework/cli/commands.hpp"
@@ -46,6 +50,7 @@ namespace fs = std::filesystem;
 struct Entry {
   std::string config;
   std::vector<std::string> overrides;
+  std::string run_id;  ///< empty: the sweep's name
 };
 
 struct Sweep {
@@ -76,6 +81,7 @@ struct Sweep {
         config::Fields r(runs[i], "a sweep entry", {});
         r.required("config", e.config);
         r.optional("overrides", e.overrides);
+        r.optional("run_id", e.run_id);
         r.finish();
       }
       s.runs.push_back(std::move(e));
@@ -95,7 +101,8 @@ fs::path run_entry(const Sweep& sweep, const Entry& entry, int threads) {
   else o.require_training_sections(config);
   set_torch_threads(threads >= 0 ? threads : o.threads);
 
-  const fs::path dir = fs::path(o.results_dir) / o.experiment / sweep.name;
+  const std::string run_id = entry.run_id.empty() ? sweep.name : entry.run_id;
+  const fs::path dir = fs::path(o.results_dir) / o.experiment / run_id;
   const bool existed = fs::exists(dir);
   if (existed) {
     const std::string saved = read_file(dir / "config.yaml");
@@ -109,12 +116,12 @@ fs::path run_entry(const Sweep& sweep, const Entry& entry, int threads) {
   std::optional<RunDir> run;
   if (!binder) {
     train::Trainer trainer(config);
-    run = existed ? RunDir::open(dir) : train::create_run(config, o, sweep.name, command_line());
+    run = existed ? RunDir::open(dir) : train::create_run(config, o, run_id, command_line());
     const train::TrainResult r = trainer.fit(*run);
     spdlog::info("{}: {} epochs, best epoch {} (validation loss {:.6g})", o.experiment, r.epochs,
                  r.best_epoch, r.best_loss);
   } else {
-    run = existed ? RunDir::open(dir) : train::create_run(config, o, sweep.name, command_line());
+    run = existed ? RunDir::open(dir) : train::create_run(config, o, run_id, command_line());
   }
   eval::EvalOptions e;
   e.part = sweep.part;
@@ -140,11 +147,20 @@ Command add_sweep(CLI::App& app) {
                   "libtorch threads for every entry (default: each config's `threads`)");
   return {cmd, [args] {
             const Sweep sweep = Sweep::from(config::Config::load(args->file));
-            // Every entry's config must load before anything trains.
+            // Every entry's config must load before anything trains, and no two entries may
+            // share a run directory.
+            std::map<fs::path, std::string> dirs;
             for (const auto& entry : sweep.runs) {
               std::vector<std::string> overrides = sweep.overrides;
               overrides.insert(overrides.end(), entry.overrides.begin(), entry.overrides.end());
-              train::RunOptions::from(config::Config::load(entry.config, overrides));
+              const auto o = train::RunOptions::from(config::Config::load(entry.config, overrides));
+              const fs::path dir = fs::path(o.results_dir) / o.experiment /
+                                   (entry.run_id.empty() ? sweep.name : entry.run_id);
+              if (!dirs.emplace(dir, entry.config).second) {
+                throw Error(args->file + ": " + entry.config + " and " + dirs[dir] +
+                            " would share the run directory " + dir.string() +
+                            "; give one of them a run_id");
+              }
             }
             std::vector<report::RunResult> results;
             for (const auto& entry : sweep.runs) {

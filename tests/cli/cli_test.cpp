@@ -277,6 +277,36 @@ TEST(Cli, SmokeRunPrepareTrainEvalOnTheBundledSubset) {
       ASSERT_LE(nonzero, topk.cols()) << name << " vertex " << v;
     }
   }
+
+  // A sweep of two entries (two seeds) trains, evaluates and tabulates both; run again, it only
+  // re-reads the finished runs; a changed config under the same run directory is an error.
+  const auto sweep = dir.write(
+      "sweep.yaml", "name: sw\nout: " + (dir / "tables" / "sw.md").string() +
+                        "\noverrides: [data.file=" + data + ", results_dir=" + results +
+                        ", train.epochs=1]\nruns:\n  - configs/smoke.yaml\n"
+                        "  - {config: configs/smoke.yaml, overrides: [seed=1], run_id: sw-seed1}\n");
+  const Result s1 = run("sweep " + sweep.string());
+  ASSERT_EQ(s1.status, 0) << s1.err;
+  const std::string table = read_file(dir / "tables" / "sw.md");
+  EXPECT_NE(table.find("| smoke | sw | "), std::string::npos) << table;
+  EXPECT_NE(table.find("| smoke | sw-seed1 | "), std::string::npos) << table;
+  EXPECT_NE(table.find("One-way ANOVA vs smoke (sw)"), std::string::npos) << table;
+  EXPECT_TRUE(std::filesystem::exists(dir / "tables" / "sw.csv"));
+  const Result s2 = run("sweep " + sweep.string());
+  ASSERT_EQ(s2.status, 0) << s2.err;
+  EXPECT_NE(s2.err.find("nothing to train"), std::string::npos) << s2.err;
+  EXPECT_EQ(read_file(dir / "tables" / "sw.md"), table);
+  const auto clash = dir.write(
+      "clash.yaml", "name: sw\nout: x.md\noverrides: [data.file=" + data + ", results_dir=" +
+                        results + ", train.epochs=2]\nruns: [configs/smoke.yaml]\n");
+  const Result c = run("sweep " + clash.string());
+  EXPECT_EQ(c.status, 1);
+  EXPECT_NE(c.err.find("exists with another config"), std::string::npos) << c.err;
+  const auto twice = dir.write("twice.yaml", "name: t\nout: x.md\nruns: [configs/smoke.yaml, "
+                                             "configs/smoke.yaml]\n");
+  const Result t2 = run("sweep " + twice.string());
+  EXPECT_EQ(t2.status, 1);
+  EXPECT_NE(t2.err.find("would share the run directory"), std::string::npos) << t2.err;
 }
 
 }  // namespace

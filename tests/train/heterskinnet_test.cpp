@@ -100,6 +100,12 @@ TEST(HeterSkinNet, ShippedExperimentConfigsValidate) {
     EXPECT_NO_THROW(options.require_training_sections(config)) << file;
     EXPECT_NO_THROW(model_registry().create(options.model)) << file;
   }
+  for (const char* file : {"baselines/geo_voxel.yaml", "baselines/bone_heat.yaml"}) {
+    const auto config = config::Config::load(std::string(SKINLAB_SOURCE_DIR) + "/configs/" + file);
+    const auto options = train::RunOptions::from(config);
+    EXPECT_NO_THROW(options.require_binder_sections(config)) << file;
+    EXPECT_THROW(options.require_training_sections(config), ConfigError) << file;
+  }
 }
 
 }  // namespace
