@@ -3,6 +3,7 @@
 /// [--out file]`: the comparison table of saved, evaluated runs (framework/report/table.hpp);
 /// the first run is the reference of the ANOVA columns. Without --out it prints the table.
 
+#include <filesystem>
 #include <iostream>
 
 #include "framework/cli/commands.hpp"
@@ -34,14 +35,20 @@ Command add_table(CLI::App& app) {
             std::vector<report::RunResult> runs;
             for (const auto& dir : args->runs) runs.push_back(report::load_run_result(dir, args->part));
             std::string command;
-            for (std::size_t i = 1; i < command_line().size(); ++i) command += " " + command_line()[i];
+            for (std::size_t i = 1; i < command_line().size(); ++i) {
+              const std::string& word = command_line()[i];
+              const bool plain = word.find_first_of(" \t'\"$`\\*?;&|()<>") == std::string::npos;
+              command += plain ? " " + word : " '" + word + "'";
+            }
             command = "skinlab" + command;
             args->options.command = command;
             const std::string text = report::make_table(runs, args->options);
             if (args->out.empty()) {
               std::cout << text;
             } else {
-              write_file_atomic(args->out, text);
+              const std::filesystem::path out = args->out;
+              if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
+              write_file_atomic(out, text);
               std::cout << "wrote " << args->out << " (" << runs.size() << " runs)\n";
             }
             return 0;
