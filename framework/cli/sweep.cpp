@@ -13,6 +13,7 @@
 ///     runs:                             # the first is the reference of the ANOVA columns
 ///       - configs/heterskinnet.yaml
 ///       - {config: configs/ablations/euclidean.yaml, overrides: [seed=1], run_id: table4-seed1}
+///       - {run: results/heterskinnet/full-20261123}   # an existing run: evaluated if needed
 ///
 /// An entry's run id is the sweep's name unless it sets `run_id`; two entries that would share a
 /// run directory (same experiment and run id) are an error.
@@ -48,6 +49,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct Entry {
+  std::string run;     ///< an existing run directory (then `config` is empty)
   std::string config;
   std::vector<std::string> overrides;
   std::string run_id;  ///< empty: the sweep's name
@@ -79,9 +81,14 @@ struct Sweep {
         e.config = runs[i].as<std::string>();
       } else {
         config::Fields r(runs[i], "a sweep entry", {});
-        r.required("config", e.config);
+        r.optional("run", e.run);
+        r.optional("config", e.config);
         r.optional("overrides", e.overrides);
         r.optional("run_id", e.run_id);
+        r.check(e.run.empty() != e.config.empty(), "config",
+                "give either `config:` (a run to make) or `run:` (an existing run directory)");
+        r.check(e.run.empty() || (e.overrides.empty() && e.run_id.empty()), "run",
+                "an existing run takes no overrides or run_id");
         r.finish();
       }
       s.runs.push_back(std::move(e));
@@ -92,6 +99,18 @@ struct Sweep {
 
 /// Trains or opens the run of one entry and evaluates it; returns its run directory.
 fs::path run_entry(const Sweep& sweep, const Entry& entry, int threads) {
+  if (!entry.run.empty()) {
+    const RunDir run = RunDir::open(entry.run);
+    std::cout << fmt::format("== {} (existing run)\n", entry.run);
+    if (!fs::exists(run.file("eval_" + sweep.part + ".json"))) {
+      eval::EvalOptions e;
+      e.part = sweep.part;
+      e.predictions = sweep.predictions;
+      if (threads >= 0) set_torch_threads(threads);
+      eval::evaluate(run, e);
+    }
+    return run.path();
+  }
   std::vector<std::string> overrides = sweep.overrides;
   overrides.insert(overrides.end(), entry.overrides.begin(), entry.overrides.end());
   const config::Config config = config::Config::load(entry.config, overrides);
@@ -151,6 +170,10 @@ Command add_sweep(CLI::App& app) {
             // share a run directory.
             std::map<fs::path, std::string> dirs;
             for (const auto& entry : sweep.runs) {
+              if (!entry.run.empty()) {
+                RunDir::open(entry.run);  // must exist
+                continue;
+              }
               std::vector<std::string> overrides = sweep.overrides;
               overrides.insert(overrides.end(), entry.overrides.begin(), entry.overrides.end());
               const auto o = train::RunOptions::from(config::Config::load(entry.config, overrides));
