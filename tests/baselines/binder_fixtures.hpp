@@ -151,6 +151,20 @@ inline void expect_valid_rows(const Eigen::MatrixXd& W, int rows, int cols) {
   }
 }
 
+/// The chain tube and its triangulation are symmetric under x → −x (side j ↔ side kSides/2 − j):
+/// so must the weights be, to 1e-6.
+inline void expect_mirror_symmetric(const Eigen::MatrixXd& W) {
+  for (int i = 0; i < Chain::kRings; ++i) {
+    for (int j = 0; j < Chain::kSides; ++j) {
+      const int mirror = (Chain::kSides / 2 - j + Chain::kSides) % Chain::kSides;
+      for (Eigen::Index b = 0; b < W.cols(); ++b) {
+        EXPECT_NEAR(W(Chain::vertex(i, j), b), W(Chain::vertex(i, mirror), b), 1e-6)
+            << "ring " << i << " side " << j << " bone " << b;
+      }
+    }
+  }
+}
+
 inline std::shared_ptr<binders::Binder> make_binder(const std::string& yaml) {
   return binder_registry().create(config::Config::parse(yaml, "test.yaml").root());
 }

@@ -51,16 +51,7 @@ TEST(BoneHeat, ChainWeightsAreValidLocalAndMonotonic) {
 
 TEST(BoneHeat, MirrorSymmetricInputGivesMirrorSymmetricWeights) {
   const Chain c = testing::chain();
-  const Eigen::MatrixXd W = BoneHeat({}).bind(c.mesh, c.skeleton);
-  for (int i = 0; i < Chain::kRings; ++i) {
-    for (int j = 0; j < Chain::kSides; ++j) {
-      const int mirror = (Chain::kSides / 2 - j + Chain::kSides) % Chain::kSides;
-      for (int b = 0; b < 4; ++b) {
-        EXPECT_NEAR(W(Chain::vertex(i, j), b), W(Chain::vertex(i, mirror), b), 1e-6)
-            << "ring " << i << " side " << j << " bone " << b;
-      }
-    }
-  }
+  testing::expect_mirror_symmetric(BoneHeat({}).bind(c.mesh, c.skeleton));
 }
 
 // Wound inwards (as every prepared game character is), the mesh is re-oriented first: same
