@@ -6,7 +6,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <map>
+#include <sstream>
+#include <string>
 
 #include "framework/core/environment.hpp"
 #include "framework/core/error.hpp"
