@@ -104,7 +104,7 @@ TEST(Registry, ExactKeysOfEveryCategory) {
   const std::map<std::string, std::vector<std::string>> expected = {
       {"distance", {"euclidean", "hollow_dist", "volumetric_geodesic"}},
       {"graph_op", {"b2v", "edge_conv", "global_pool", "mesh_conv", "v2b"}},
-      {"model", {"heterskinnet"}},
+      {"model", {"heterskinnet", "rignet_skin"}},
       {"loss", {"kl", "laplacian_smoothing", "mse", "soft_cross_entropy"}},
       {"metric", {"avg_l1", "deformation_error", "precision_recall"}},
       {"dataset", {"cube2", "folder", "nexuiz", "zeroad"}},
