@@ -28,26 +28,12 @@ const config::Config& defaults() {
 RigNetSkin::Options RigNetSkin::Options::from(const config::Node& node) {
   Options o;
   config::Fields f(node, "model rignet_skin");
-  f.optional("top_k", o.top_k);
-  f.optional("distance_unit", o.distance_unit);
-  f.optional("min_distance", o.min_distance);
+  o.read(f);
   f.optional("leaf_flag", o.leaf_flag);
   f.optional("input_mlp", o.input_mlp);
-  o.stem = f.section("stem");
-  o.local = f.section("local");
-  o.global = f.section("global");
-  f.optional("head", o.head);
-  f.optional("head_dropout", o.head_dropout);
-  f.check(o.top_k >= 1, "top_k", "must be ≥ 1");
-  f.check(o.distance_unit > 0, "distance_unit", "must be positive");
-  f.check(o.min_distance > 0, "min_distance", "must be positive");
   for (auto w : o.input_mlp) f.check(w >= 1, "input_mlp", "widths must be ≥ 1");
-  for (auto w : o.head) f.check(w >= 1, "head", "widths must be ≥ 1");
-  f.check(o.head_dropout >= 0 && o.head_dropout < 1, "head_dropout", "must be in [0, 1)");
   f.finish();
-  if (!o.stem.exists()) o.stem = defaults().root()["stem"];
-  if (!o.local.exists()) o.local = defaults().root()["local"];
-  if (!o.global.exists()) o.global = defaults().root()["global"];
+  o.fill_missing_branches(defaults());
   return o;
 }
 
@@ -79,10 +65,7 @@ torch::Tensor RigNetSkin::input_features(const data::CharacterTensors& c) const 
   const torch::Tensor flat = c.topk_index.reshape({-1});
   std::vector<torch::Tensor> parts;
   parts.push_back(c.bones.index_select(0, flat).reshape({nv, k, 6}));  // start ‖ end
-  parts.push_back((c.topk_distance / options_.distance_unit)
-                      .clamp_min(options_.min_distance)
-                      .reciprocal()
-                      .reshape({nv, k, 1}));
+  parts.push_back(models::inverse_distance(c.topk_distance, options_).reshape({nv, k, 1}));
   if (options_.leaf_flag) {
     // RigNet's virtual leaf bone is our helper bone at a leaf joint: start joint == end joint.
     const torch::Tensor leaf =

@@ -55,21 +55,20 @@
 #include "framework/core/config.hpp"
 #include "framework/graph/graph_op.hpp"
 #include "framework/graph/mlp.hpp"
+#include "framework/models/branched_model.hpp"
 #include "framework/models/model.hpp"
 
 namespace skinlab::baselines {
 
 class RigNetSkin final : public models::Model {
  public:
-  struct Options {
-    std::int64_t top_k = 3;             ///< K (HeterSkinNet Sec. 4.5); the dataset's top-K
-    double distance_unit = 1.0 / 88.0;  ///< metres per unit of D
-    double min_distance = 1.0;          ///< in `distance_unit`s; D is clamped to this before 1/D
+  /// top_k (K = 3, HeterSkinNet Sec. 4.5), distance_unit, min_distance, stem/local/global
+  /// (missing: RigNet's widths) and head as models/branched_model.hpp; RigNet's head has no
+  /// dropout.
+  struct Options : models::BranchedModelOptions {
+    Options() { head_dropout = 0.0; }
     bool leaf_flag = true;              ///< RigNet's `--Lf` input (8 values per bone, else 7)
     std::vector<std::int64_t> input_mlp = {128, 64};  ///< SKINNING.py l. 31
-    config::Node stem, local, global;   ///< op lists / op node; missing: RigNet's widths
-    std::vector<std::int64_t> head = {1024, 512};  ///< hidden widths before the K logits
-    double head_dropout = 0.0;          ///< RigNet has none
     static Options from(const config::Node& node);
   };
   explicit RigNetSkin(Options options);

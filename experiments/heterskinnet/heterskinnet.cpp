@@ -36,24 +36,10 @@ const config::Config& defaults() {
 HeterSkinNet::Options HeterSkinNet::Options::from(const config::Node& node) {
   Options o;
   config::Fields f(node, "model heterskinnet");
-  f.optional("top_k", o.top_k);
-  f.optional("distance_unit", o.distance_unit);
-  f.optional("min_distance", o.min_distance);
+  o.read(f);
   o.edge_dropout = graph::EdgeDropoutOptions::from(f.section("edge_dropout"));
-  o.stem = f.section("stem");
-  o.local = f.section("local");
-  o.global = f.section("global");
-  f.optional("head", o.head);
-  f.optional("head_dropout", o.head_dropout);
-  f.check(o.top_k >= 1, "top_k", "must be ≥ 1");
-  f.check(o.distance_unit > 0, "distance_unit", "must be positive");
-  f.check(o.min_distance > 0, "min_distance", "must be positive");
-  for (auto w : o.head) f.check(w >= 1, "head", "widths must be ≥ 1");
-  f.check(o.head_dropout >= 0 && o.head_dropout < 1, "head_dropout", "must be in [0, 1)");
   f.finish();
-  if (!o.stem.exists()) o.stem = defaults().root()["stem"];
-  if (!o.local.exists()) o.local = defaults().root()["local"];
-  if (!o.global.exists()) o.global = defaults().root()["global"];
+  o.fill_missing_branches(defaults());
   return o;
 }
 
@@ -90,10 +76,7 @@ torch::Tensor HeterSkinNet::forward(const data::CharacterTensors& c) {
 
   graph::Features in;
   in.vertex =
-      torch::cat({c.positions, (c.topk_distance / options_.distance_unit)
-                                   .clamp_min(options_.min_distance)
-                                   .reciprocal()},
-                 1);
+      torch::cat({c.positions, models::inverse_distance(c.topk_distance, options_)}, 1);
   in.bone = c.bones;
   const graph::Features x = stem_->forward(in, g);
   const graph::Features glob = global_->forward(x, g);

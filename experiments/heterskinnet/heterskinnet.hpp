@@ -41,20 +41,17 @@
 #include "framework/graph/edge_dropout.hpp"
 #include "framework/graph/graph_op.hpp"
 #include "framework/graph/mlp.hpp"
+#include "framework/models/branched_model.hpp"
 #include "framework/models/model.hpp"
 
 namespace skinlab::experiments {
 
 class HeterSkinNet final : public models::Model {
  public:
-  struct Options {
-    std::int64_t top_k = 3;      ///< K (Sec. 4.2); must equal the dataset's top-K
-    double distance_unit = 1.0 / 88.0;  ///< metres per unit of D (one 88³ HollowDist cell)
-    double min_distance = 1.0;          ///< in `distance_unit`s; D is clamped to this before 1/D
+  /// top_k (K = 3, Sec. 4.2), distance_unit, min_distance, stem/local/global (missing: the
+  /// paper's widths), head [1024, 512] and head_dropout 0.5: models/branched_model.hpp.
+  struct Options : models::BranchedModelOptions {
     graph::EdgeDropoutOptions edge_dropout;
-    config::Node stem, local, global;  ///< op lists / op node; missing: the paper's defaults
-    std::vector<std::int64_t> head = {1024, 512};  ///< hidden widths before the K logits
-    double head_dropout = 0.5;
     static Options from(const config::Node& node);
   };
   explicit HeterSkinNet(Options options);
