@@ -2,6 +2,8 @@
 
 #include "framework/core/error.hpp"
 #include "framework/data/preprocess.hpp"
+#include "framework/geometry/orient_outward.hpp"
+#include "framework/geometry/vertex_normals.hpp"
 
 namespace skinlab::data {
 
@@ -47,6 +49,11 @@ CharacterTensors to_tensors(const PreparedCharacter& character, const std::strin
   t.name = character.name;
   t.distance = distance;
   t.positions = to_float(character.V);
+  {
+    geometry::Mesh mesh{character.V, character.F};
+    if (mesh.F.rows() > 0) mesh = geometry::orient_outward(mesh);
+    t.normals = to_float(RowMatrixXd(geometry::vertex_normals(mesh)));
+  }
   t.topk_index = to_long(d.topk_index);
   t.topk_distance = to_float(d.topk_distance);
 
@@ -90,12 +97,10 @@ CharacterTensors to_tensors(const PreparedCharacter& character, const std::strin
     throw IoError(where + ": Laplacian has " + std::to_string(character.laplacian_indices.rows()) +
                   " index pairs for " + std::to_string(n) + " values");
   }
-  const torch::Tensor indices =
-      n > 0 ? to_long(character.laplacian_indices).t().contiguous()
-            : torch::zeros({2, 0}, torch::kInt64);
+  const torch::Tensor indices = n > 0 ? to_long(character.laplacian_indices).t().contiguous()
+                                      : torch::zeros({2, 0}, torch::kInt64);
   const torch::Tensor values =
-      torch::from_blob(const_cast<double*>(character.laplacian_values.data()), {n},
-                       torch::kFloat64)
+      torch::from_blob(const_cast<double*>(character.laplacian_values.data()), {n}, torch::kFloat64)
           .to(torch::kFloat32);
   t.laplacian = torch::sparse_coo_tensor(indices, values, {nv, nv}).coalesce();
   return t;

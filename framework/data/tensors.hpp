@@ -23,10 +23,13 @@ namespace skinlab::data {
 
 struct CharacterTensors {
   std::string name;
-  std::string distance;        ///< distance registry key the top-K and targets come from
-  torch::Tensor positions;     ///< #V×3 float32 vertex positions
-  torch::Tensor topk_index;    ///< #V×K int64 candidate bones, nearest first
-  torch::Tensor topk_distance; ///< #V×K float32 their distances (metres), ascending
+  std::string distance;     ///< distance registry key the top-K and targets come from
+  torch::Tensor positions;  ///< #V×3 float32 vertex positions
+  /// #V×3 float32 unit area-weighted vertex normals of the faces oriented outwards per part
+  /// (geometry/orient_outward.hpp, vertex_normals.hpp); zero for a vertex on no face
+  torch::Tensor normals;
+  torch::Tensor topk_index;     ///< #V×K int64 candidate bones, nearest first
+  torch::Tensor topk_distance;  ///< #V×K float32 their distances (metres), ascending
   /// #V×K float32 ground-truth distribution over the candidates: the dataset's `targets`
   /// renormalised per row (weight outside the K candidates is dropped, Sec. 3.2); a row whose
   /// candidates carry no weight at all stays all-zero.
