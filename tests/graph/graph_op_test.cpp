@@ -261,7 +261,7 @@ TEST(Sequence, ConfigErrorsNameTheEntry) {
   const auto root = config.root();
   expect_error<RegistryError>([&] { Sequence::from(root["a"]); },
                               {"test.yaml:3: a[1]", "unknown graph_op type 'spectral_conv'",
-                               "b2v, edge_conv, global_pool, mesh_conv, v2b"});
+                               "b2v, edge_conv, gconv_pool, global_pool, mesh_conv, v2b"});
   expect_error<ConfigError>(
       [&] { Sequence::from(root["b"]); },
       {"test.yaml:5", "unknown field of graph_op 'edge_conv'", "did you mean 'self_loops'?"});
@@ -299,6 +299,7 @@ const std::map<std::string, std::string>& op_configs() {
       {"v2b", "{type: v2b, mlp: [4, 3]}"},
       {"b2v", "{type: b2v, mlp: [4, 3]}"},
       {"global_pool", "{type: global_pool, vertex_mlp: [3], bone_mlp: [2], to: [vertex, bone]}"},
+      {"gconv_pool", "{type: gconv_pool, mlp: [4, 3]}"},
   };
   return configs;
 }
