@@ -53,38 +53,30 @@
 #include <vector>
 
 #include "framework/core/config.hpp"
-#include "framework/graph/graph_op.hpp"
-#include "framework/graph/mlp.hpp"
 #include "framework/models/branched_model.hpp"
-#include "framework/models/model.hpp"
 
 namespace skinlab::baselines {
 
-class RigNetSkin final : public models::Model {
+class RigNetSkin final : public models::BranchedNetwork {
  public:
   /// top_k (K = 3, HeterSkinNet Sec. 4.5), distance_unit, min_distance, stem/local/global
   /// (missing: RigNet's widths) and head as models/branched_model.hpp; RigNet's head has no
   /// dropout.
   struct Options : models::BranchedModelOptions {
     Options() { head_dropout = 0.0; }
-    bool leaf_flag = true;              ///< RigNet's `--Lf` input (8 values per bone, else 7)
+    bool leaf_flag = true;  ///< RigNet's `--Lf` input (8 values per bone, else 7)
     std::vector<std::int64_t> input_mlp = {128, 64};  ///< SKINNING.py l. 31
     static Options from(const config::Node& node);
   };
   explicit RigNetSkin(Options options);
 
-  /// #V×K softmax over the candidates `c.topk_index`.
-  torch::Tensor forward(const data::CharacterTensors& c) override;
   /// The #V×(3 + 8K) (or 3 + 7K without the leaf flag) input features f_v.
-  torch::Tensor input_features(const data::CharacterTensors& c) const;
+  torch::Tensor input_features(const data::CharacterTensors& c) const override;
 
   const Options& options() const { return options_; }
 
  private:
   Options options_;
-  graph::Mlp input_{nullptr}, head_{nullptr};
-  std::shared_ptr<graph::Sequence> stem_, local_;
-  std::shared_ptr<graph::GraphOp> global_;
 };
 
 }  // namespace skinlab::baselines

@@ -1,8 +1,10 @@
 #pragma once
 /// \file
 /// What the models assembled from `graph_op` branches share (`heterskinnet`,
-/// experiments/heterskinnet/; `rignet_skin`, baselines/rignet_skin/): the K candidate bones,
-/// the 1/D input and its unit, the `stem` / `local` / `global` op lists, and the head MLP.
+/// experiments/heterskinnet/; `rignet_skin`, baselines/rignet_skin/; `neuroskinning`,
+/// baselines/neuroskinning/): the K candidate bones, the 1/D input and its unit, the `stem` /
+/// `local` / `global` op lists, and the head MLP; and `BranchedNetwork`, the whole network of
+/// the two baselines, which differ only in their input features and their ops.
 ///
 /// 1/D is measured in `distance_unit`s (default one HollowDist cell, 1/88 of the normalised 1 m
 /// frame, HeterSkinNet Sec. 4.2) and D is clamped below at `min_distance` units, so 1/D ≤
@@ -12,9 +14,14 @@
 #include <torch/torch.h>
 
 #include <cstdint>
+#include <memory>
+#include <string>
 #include <vector>
 
 #include "framework/core/config.hpp"
+#include "framework/graph/graph_op.hpp"
+#include "framework/graph/mlp.hpp"
+#include "framework/models/model.hpp"
 
 namespace skinlab::models {
 
@@ -35,5 +42,38 @@ struct BranchedModelOptions {
 /// #V×K: 1 / max(D / distance_unit, min_distance) of the candidates' distances (#V×K metres).
 torch::Tensor inverse_distance(const torch::Tensor& topk_distance,
                                const BranchedModelOptions& options);
+
+/// The network RigNet's skinning network (Xu et al. 2020, Sec. 3.3) and NeuroSkinning (Liu et al.
+/// 2019, Fig. 3) both are, given per-vertex input features f_v:
+///
+///     x0 = MLP_input(f_v)          # per vertex, shared ("multi-layer transform")
+///     x1 = stem(x0)                # graph ops
+///     g  = global(x1)              # e.g. max-pooled MLP, repeated to every vertex
+///     x3 = local(x1)               # graph ops
+///     w  = softmax(head(x3 ‖ g))   # over the K candidate bones
+///
+/// Submodules `input`, `stem`, `local`, `global_branch` ("global" is a Python keyword, which
+/// libtorch checkpoints cannot store as a module name) and `head`. Bone attributes [start, end]
+/// (width 6) ride along, so a config may add skeleton ops; neither baseline uses any.
+class BranchedNetwork : public Model {
+ public:
+  /// #V×K softmax over the candidates `c.topk_index`.
+  torch::Tensor forward(const data::CharacterTensors& c) override;
+  /// The #V×`input_width` features f_v.
+  virtual torch::Tensor input_features(const data::CharacterTensors& c) const = 0;
+
+ protected:
+  /// `name` (the registry key) prefixes messages; `input_width` is the width of f_v and
+  /// `input_mlp` the widths of MLP_input. Builds and registers every submodule.
+  BranchedNetwork(std::string name, const BranchedModelOptions& options, std::int64_t input_width,
+                  const std::vector<std::int64_t>& input_mlp);
+
+ private:
+  std::string name_;
+  std::int64_t top_k_;
+  graph::Mlp input_{nullptr}, head_{nullptr};
+  std::shared_ptr<graph::Sequence> stem_, local_;
+  std::shared_ptr<graph::GraphOp> global_;
+};
 
 }  // namespace skinlab::models

@@ -19,6 +19,7 @@
 #include "framework/losses/loss.hpp"
 #include "framework/train/run_options.hpp"
 #include "framework/train/trainer.hpp"
+#include "tests/baselines/model_fixtures.hpp"
 #include "tests/test_util.hpp"
 #include "tests/train/train_fixtures.hpp"
 
@@ -41,20 +42,10 @@ constexpr const char* kTiny =
     "head: [32, 16]\n";
 
 std::shared_ptr<RigNetSkin> make(const std::string& yaml) {
-  auto model = model_registry().create(config::Config::parse(yaml, "m.yaml").root());
-  auto rignet = std::dynamic_pointer_cast<RigNetSkin>(model);
-  if (!rignet) throw std::runtime_error("rignet_skin did not build a RigNetSkin");
-  return rignet;
+  return testing::make_model<RigNetSkin>(yaml);
 }
 
-const data::CharacterTensors& tube(int index) {
-  static std::map<int, data::CharacterTensors> cache;
-  auto it = cache.find(index);
-  if (it == cache.end()) {
-    it = cache.emplace(index, data::to_tensors(testing::prepared_tube(index), "euclidean")).first;
-  }
-  return it->second;
-}
+const data::CharacterTensors& tube(int index) { return testing::tube_tensors(index); }
 
 const fs::path& tubes() {
   static testing::TempDir dir;
@@ -66,12 +57,7 @@ const fs::path& tubes() {
   return file;
 }
 
-void expect_valid_rows(const torch::Tensor& w, const data::CharacterTensors& c) {
-  ASSERT_EQ(w.sizes(), (std::vector<std::int64_t>{c.num_vertices(), 3}));
-  EXPECT_TRUE(torch::isfinite(w).all().item<bool>());
-  EXPECT_TRUE((w >= 0).all().item<bool>());
-  EXPECT_TRUE(torch::allclose(w.sum(1), torch::ones({c.num_vertices()}), 1e-5, 1e-5));
-}
+using testing::expect_valid_rows;
 
 TEST(RigNetSkin, DefaultsAreRigNetsWidths) {
   const auto m = make("type: rignet_skin");
@@ -116,8 +102,8 @@ TEST(RigNetSkin, InputFeaturesFollowRigNetsLayout) {
       EXPECT_TRUE(torch::equal(rec.slice(0, 0, 6), c.bones[b]));
       const double d = c.topk_distance[v][k].item<float>();
       EXPECT_NEAR(rec[6].item<float>(), 1.0 / std::max(d / 0.01, 2.0), 1e-5);
-      const bool leaf = c.bone_joints[b][0].item<std::int64_t>() ==
-                        c.bone_joints[b][1].item<std::int64_t>();
+      const bool leaf =
+          c.bone_joints[b][0].item<std::int64_t>() == c.bone_joints[b][1].item<std::int64_t>();
       EXPECT_EQ(rec[7].item<float>(), leaf ? 1.0f : 0.0f);
     }
   }
@@ -174,8 +160,8 @@ TEST(RigNetSkin, PaperWidthsStartUnsaturated) {
     const float saturated = (top > 0.99).to(torch::kFloat).mean().item<float>();
     EXPECT_LT(saturated, 0.05) << "most rows start one-hot; mean largest weight "
                                << top.mean().item<float>();
-    std::cout << c.name << ": rows with max > 0.99: " << saturated
-              << ", mean largest weight " << top.mean().item<float>() << "\n";
+    std::cout << c.name << ": rows with max > 0.99: " << saturated << ", mean largest weight "
+              << top.mean().item<float>() << "\n";
   }
 }
 
@@ -216,8 +202,11 @@ TEST(RigNetSkin, TrainingOnTubesLowersTheLoss) {
   const std::string yaml =
       "experiment: rignet_tubes\n"
       "seed: 3\n"
-      "results_dir: " + results.path().string() + "\n"
-      "model:\n" + [] {
+      "results_dir: " +
+      results.path().string() +
+      "\n"
+      "model:\n" +
+      [] {
         std::string indented;
         std::string line;
         std::istringstream in(kTiny);
@@ -225,7 +214,9 @@ TEST(RigNetSkin, TrainingOnTubesLowersTheLoss) {
         return indented;
       }() +
       "losses: [{type: soft_cross_entropy, weight: 1.0}]\n"
-      "data: {file: " + tubes().string() + ", split: random, distance: euclidean}\n"
+      "data: {file: " +
+      tubes().string() +
+      ", split: random, distance: euclidean}\n"
       "train: {epochs: 6, lr: 1.0e-3, weight_decay: 1.0e-4, patience: 0, log_every: 0}\n";
   const config::Config config = config::Config::parse(yaml, "tubes.yaml");
   train::Trainer trainer(config);
@@ -242,8 +233,8 @@ TEST(RigNetSkin, TrainingOnTubesLowersTheLoss) {
 }
 
 TEST(RigNetSkin, ShippedConfigValidates) {
-  const auto config = config::Config::load(std::string(SKINLAB_SOURCE_DIR) +
-                                           "/configs/baselines/rignet_skin.yaml");
+  const auto config =
+      config::Config::load(std::string(SKINLAB_SOURCE_DIR) + "/configs/baselines/rignet_skin.yaml");
   const auto options = train::RunOptions::from(config);
   EXPECT_NO_THROW(options.require_training_sections(config));
   EXPECT_NO_THROW(model_registry().create(options.model));

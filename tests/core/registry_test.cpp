@@ -103,8 +103,8 @@ TEST(Registry, ExactKeysOfEveryCategory) {
   for (const auto* registry : all_registries()) actual[registry->name()] = registry->keys();
   const std::map<std::string, std::vector<std::string>> expected = {
       {"distance", {"euclidean", "hollow_dist", "volumetric_geodesic"}},
-      {"graph_op", {"b2v", "edge_conv", "global_pool", "mesh_conv", "v2b"}},
-      {"model", {"heterskinnet", "rignet_skin"}},
+      {"graph_op", {"b2v", "edge_conv", "gconv_pool", "global_pool", "mesh_conv", "v2b"}},
+      {"model", {"heterskinnet", "neuroskinning", "rignet_skin"}},
       {"loss", {"kl", "laplacian_smoothing", "mse", "soft_cross_entropy"}},
       {"metric", {"avg_l1", "deformation_error", "precision_recall"}},
       {"dataset", {"cube2", "folder", "nexuiz", "zeroad"}},
