@@ -27,6 +27,7 @@ Command add_train(CLI::App& app);
 Command add_eval(CLI::App& app);
 Command add_table(CLI::App& app);
 Command add_curves(CLI::App& app);
+Command add_figure(CLI::App& app);
 Command add_sweep(CLI::App& app);
 
 /// The command line `skinlab` was started with (recorded in a run's env.json).

@@ -13,11 +13,15 @@ AvgL1::Options AvgL1::Options::from(const config::Node& node) {
   return o;
 }
 
-std::map<std::string, double> AvgL1::operator()(const MetricInputs& in) const {
+Eigen::VectorXd AvgL1::vertex_errors(const MetricInputs& in) const {
   auto [P, G] = read_weights(in, "avg_l1");
   prune_rows(P, options_.prune);
-  const double total = (P - G).cwiseAbs().sum();
-  return {{"avg_l1", P.rows() > 0 ? total / static_cast<double>(P.rows()) : 0.0}};
+  return (P - G).cwiseAbs().rowwise().sum();
+}
+
+std::map<std::string, double> AvgL1::operator()(const MetricInputs& in) const {
+  const Eigen::VectorXd e = vertex_errors(in);
+  return {{"avg_l1", e.size() > 0 ? e.mean() : 0.0}};
 }
 
 }  // namespace skinlab::eval

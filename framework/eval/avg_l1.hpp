@@ -16,6 +16,8 @@
 /// 0.5 × the row maximum), and Puppeteer's skinning/main.py computes the L1 on the pruned,
 /// renormalised prediction. `prune: 0` gives the L1 of the raw prediction.
 
+#include <Eigen/Core>
+
 #include "framework/core/config.hpp"
 #include "framework/eval/metric.hpp"
 
@@ -30,6 +32,9 @@ class AvgL1 final : public Metric {
   explicit AvgL1(Options options) : options_(options) {}
   std::map<std::string, double> operator()(const MetricInputs& in) const override;
   std::vector<std::string> names() const override { return {"avg_l1"}; }
+  /// #V per-vertex errors Σ_b |P(v, b) − G(v, b)| (pruned P), whose mean is avg_l1: the
+  /// per-vertex L1 maps of Fig. 7 and 10. Throws as operator() does.
+  Eigen::VectorXd vertex_errors(const MetricInputs& in) const;
 
  private:
   Options options_;

@@ -1,5 +1,6 @@
 // The `skinlab` binary, run as a user runs it: exit status, stdout and stderr.
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -277,6 +278,26 @@ TEST(Cli, SmokeRunPrepareTrainEvalOnTheBundledSubset) {
       ASSERT_LE(nonzero, topk.cols()) << name << " vertex " << v;
     }
   }
+
+  // Error maps of the evaluated run: a PNG per map and a PLY per map, and per-vertex L1 values
+  // whose mean is the evaluation's avg_l1 of that character (the README quotes it).
+  const std::filesystem::path figures = dir / "figures";
+  const Result f = run("figure " + run_dir.string() + " --count 1 --out " + figures.string());
+  ASSERT_EQ(f.status, 0) << f.err;
+  const auto& first = report["per_character"][0];
+  const std::string character = first["character"].get<std::string>();
+  for (const std::string& file : {character + "_l1.png", character + "_deformation.png",
+                                 "smoke/" + character + "_l1.ply",
+                                 "smoke/" + character + "_deformation.ply"}) {
+    EXPECT_TRUE(std::filesystem::exists(figures / file)) << file << "\n" << f.out;
+  }
+  EXPECT_NE(read_file(figures / "README.md")
+                .find(fmt::format("smoke {:.4f};", first["values"]["avg_l1"].get<double>())),
+            std::string::npos)
+      << read_file(figures / "README.md");
+  const Result nf = run("figure " + run_dir.string() + " --part val --out " + figures.string());
+  EXPECT_NE(nf.status, 0);
+  EXPECT_NE(nf.err.find("no saved predictions for part 'val'"), std::string::npos) << nf.err;
 
   // A sweep of two entries (two seeds) trains, evaluates and tabulates both; run again, it only
   // re-reads the finished runs; a changed config under the same run directory is an error.

@@ -1,0 +1,244 @@
+/// \file
+/// `skinlab figure <run_dir>... [--part test] [--characters a,b | --count N] [--l1-max 1]
+/// [--out dir]`: per-vertex error maps of evaluated runs side by side (HeterSkinNet Fig. 7 and
+/// 10: L1 error of the weights; and the deformation error of Sec. 4.3 per vertex), one PNG per
+/// character and map, and one vertex-coloured PLY per run, character and map
+/// (framework/report/mesh_figure.hpp). Reads each run's saved predictions
+/// (`predictions/<part>.h5`, written by `skinlab eval`), the dataset its config names, and the
+/// run's own `metrics:` options (pruning, poses), so the maps average to the run's eval numbers.
+/// Writes `<out>/README.md` with the captions and the command.
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <memory>
+
+#include "framework/cli/commands.hpp"
+#include "framework/core/atomic_file.hpp"
+#include "framework/core/config.hpp"
+#include "framework/core/error.hpp"
+#include "framework/core/run_dir.hpp"
+#include "framework/data/dataset_file.hpp"
+#include "framework/data/h5.hpp"
+#include "framework/data/tensors.hpp"
+#include "framework/eval/avg_l1.hpp"
+#include "framework/eval/deformation_error.hpp"
+#include "framework/eval/evaluate.hpp"
+#include "framework/report/mesh_figure.hpp"
+
+namespace skinlab::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// One evaluated run: its label, dataset, predictions and per-vertex metrics.
+struct FigureRun {
+  fs::path dir;
+  std::string experiment;
+  fs::path dataset;
+  std::unique_ptr<data::H5Reader> predictions;
+  std::string distance;
+  std::shared_ptr<eval::AvgL1> l1;
+  std::shared_ptr<eval::DeformationError> deformation;
+};
+
+FigureRun open_run(const std::string& dir, const std::string& part) {
+  FigureRun r;
+  const RunDir run = RunDir::open(dir);
+  r.dir = run.path();
+  const config::Config config = config::Config::load(run.file("config.yaml"));
+  const config::Node root = config.root();
+  r.experiment = root["experiment"].as<std::string>();
+  r.dataset = root["data"]["file"].as<std::string>();
+  const fs::path file = run.file("predictions") / (part + ".h5");
+  if (!fs::exists(file)) {
+    throw IoError(
+        fmt::format("{}: no saved predictions for part '{}' (run `skinlab eval {} "
+                    "--split {}` first)",
+                    file.string(), part, dir, part));
+  }
+  r.predictions = std::make_unique<data::H5Reader>(file);
+  r.distance = r.predictions->read_attribute("/", "distance");
+  if (root["metrics"].exists()) {
+    for (const auto& m : eval::make_metrics(root["metrics"])) {
+      if (auto a = std::dynamic_pointer_cast<eval::AvgL1>(m)) r.l1 = a;
+      if (auto d = std::dynamic_pointer_cast<eval::DeformationError>(m)) r.deformation = d;
+    }
+  }
+  if (!r.l1) r.l1 = std::make_shared<eval::AvgL1>(eval::AvgL1::Options{});
+  if (!r.deformation) {
+    r.deformation = std::make_shared<eval::DeformationError>(eval::DeformationError::Options{});
+  }
+  return r;
+}
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  const auto k = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1));
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+
+/// The smallest 1, 2 or 5 × 10^k at or above x (x > 0): a colour-bar maximum with short labels.
+double nice_ceiling(double x) {
+  const double p = std::pow(10.0, std::floor(std::log10(x)));
+  for (double m : {1.0, 2.0, 5.0, 10.0}) {
+    if (m * p >= x * (1 - 1e-12)) return m * p;
+  }
+  return 10 * p;
+}
+
+/// One map's figure: a column per run (front view above the side view), a colour bar below.
+report::Image panel(const data::PreparedCharacter& c,
+                    const std::vector<std::vector<double>>& values, double vmax) {
+  std::vector<report::Image> columns;
+  for (const auto& v : values) {
+    const auto colours = report::colour_values(v, vmax);
+    report::RenderOptions front, side;
+    side.azimuth_degrees = 90;
+    columns.push_back(report::compose_column({report::render_mesh(c.V, c.F, colours, front),
+                                              report::render_mesh(c.V, c.F, colours, side)},
+                                             4));
+  }
+  const int decimals = vmax >= 1 ? 1 : static_cast<int>(std::ceil(-std::log10(vmax))) + 1;
+  const report::Image bar = report::colour_bar(240, 14, vmax, decimals);
+  return report::compose_row(columns, 12, &bar);
+}
+
+}  // namespace
+
+Command add_figure(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "figure", "per-vertex L1 and deformation error maps of evaluated runs (PNG and PLY)");
+  struct Args {
+    std::vector<std::string> runs;
+    std::string part = "test";
+    std::vector<std::string> characters;
+    int count = 3;
+    double l1_max = 1.0;
+    std::string out;
+  };
+  auto args = std::make_shared<Args>();
+  cmd->add_option("runs", args->runs, "evaluated run directories, one column each")->required();
+  cmd->add_option("--part", args->part, "evaluated part (predictions/<part>.h5)")
+      ->capture_default_str();
+  cmd->add_option("--characters", args->characters, "characters to draw (default: --count)")
+      ->delimiter(',');
+  cmd->add_option("--count", args->count, "the first N characters of the part")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--l1-max", args->l1_max, "top of the L1 colour scale (L1 is in [0, 2])")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--out", args->out, "output directory")->required();
+  return {
+      cmd, [args] {
+        std::vector<FigureRun> runs;
+        for (const auto& dir : args->runs) runs.push_back(open_run(dir, args->part));
+        std::vector<std::string> names = args->characters;
+        if (names.empty()) {
+          names = runs[0].predictions->read_strings("/character_names");
+          if (static_cast<int>(names.size()) > args->count) names.resize(args->count);
+        }
+        std::map<fs::path, data::Dataset> datasets;
+        for (const auto& r : runs) {
+          if (!datasets.count(r.dataset))
+            datasets.emplace(r.dataset, data::read_dataset(r.dataset));
+        }
+        const fs::path out = args->out;
+        fs::create_directories(out);
+        std::string readme = "# Per-vertex error maps\n\nGenerated by `skinlab figure";
+        for (const auto& dir : args->runs) readme += " " + dir;
+        readme += fmt::format(" --part {} --characters {} --l1-max {} --out {}`.\n\n", args->part,
+                              fmt::join(names, ","), args->l1_max, args->out);
+        readme += "Columns, left to right:";
+        for (const auto& r : runs)
+          readme += fmt::format(" `{}` ({})", r.experiment, r.dir.string());
+        readme +=
+            ". Top: the character seen from +Z; bottom: from +X. Colour: viridis from 0 (dark "
+            "purple) to the scale's top (yellow; larger values saturate). PLY files with the "
+            "same colours and the values as a vertex property are in one folder per run.\n\n";
+
+        for (const auto& name : names) {
+          std::vector<std::vector<double>> l1, deformation;
+          const data::PreparedCharacter* character = nullptr;
+          for (auto& r : runs) {
+            const std::string group = "/characters/" + name;
+            if (!r.predictions->has(group + "/prepared_weights")) {
+              throw IoError(fmt::format("{}: character '{}' has no predictions for part '{}'",
+                                        r.dir.string(), name, args->part));
+            }
+            const auto& chars = datasets.at(r.dataset).characters;
+            const auto it = std::find_if(chars.begin(), chars.end(),
+                                         [&](const auto& c) { return c.name == name; });
+            if (it == chars.end()) {
+              throw IoError(fmt::format("{}: no character '{}'", r.dataset.string(), name));
+            }
+            character = &*it;
+            data::RowMatrixXf W = r.predictions->read_float(group + "/prepared_weights");
+            const torch::Tensor pred =
+                torch::from_blob(W.data(), {W.rows(), W.cols()}, torch::kFloat32).clone();
+            const eval::MetricInputs in{pred, data::to_tensors(*it, r.distance).bone_weights, &*it};
+            const Eigen::VectorXd e = r.l1->vertex_errors(in);
+            l1.emplace_back(e.data(), e.data() + e.size());
+            const Eigen::VectorXd d = r.deformation->vertex_distances(in).colwise().mean();
+            deformation.emplace_back(d.data(), d.data() + d.size());
+            const fs::path folder = out / r.experiment;
+            fs::create_directories(folder);
+            const std::string comment =
+                fmt::format("{} {} part {}", r.dir.string(), name, args->part);
+            report::write_coloured_ply(folder / (name + "_l1.ply"), it->V, it->F,
+                                       report::colour_values(l1.back(), args->l1_max), "l1_error",
+                                       l1.back(), comment);
+          }
+          std::vector<double> all;
+          for (const auto& d : deformation) all.insert(all.end(), d.begin(), d.end());
+          const double deformation_max = nice_ceiling(std::max(percentile(all, 0.99), 1e-6));
+          for (std::size_t i = 0; i < runs.size(); ++i) {
+            report::write_coloured_ply(
+                out / runs[i].experiment / (name + "_deformation.ply"), character->V, character->F,
+                report::colour_values(deformation[i], deformation_max), "deformation_error",
+                deformation[i], runs[i].dir.string() + " " + name);
+          }
+          report::write_png(out / (name + "_l1.png"), panel(*character, l1, args->l1_max));
+          report::write_png(out / (name + "_deformation.png"),
+                            panel(*character, deformation, deformation_max));
+          readme += fmt::format("## {}\n\n", name);
+          readme += fmt::format(
+              "![L1]({0}_l1.png)\n\n`{0}_l1.png`: per-vertex L1 error Σ_b |P − G| of the "
+              "pruned predicted bone weights against the artist weights, scale 0 – {1}. "
+              "Means:",
+              name, args->l1_max);
+          for (std::size_t i = 0; i < runs.size(); ++i) {
+            double s = 0;
+            for (double v : l1[i]) s += v;
+            readme += fmt::format(" {} {:.4f};", runs[i].experiment, s / l1[i].size());
+          }
+          readme += fmt::format(
+              "\n\n![deformation]({0}_deformation.png)\n\n`{0}_deformation.png`: per-vertex "
+              "deformation error (distance between the vertex skinned with the predicted and "
+              "with the artist weights, mean over the evaluation poses), scale 0 – {1} m of "
+              "the 1 m-tall normalised character. Means:",
+              name, deformation_max);
+          for (std::size_t i = 0; i < runs.size(); ++i) {
+            double s = 0;
+            for (double v : deformation[i]) s += v;
+            readme += fmt::format(" {} {:.6f};", runs[i].experiment, s / deformation[i].size());
+          }
+          readme += "\n\n";
+          std::cout << fmt::format(
+              "{}: wrote {}_l1.png and {}_deformation.png (deformation "
+              "scale 0 - {} m)\n",
+              name, (out / name).string(), name, deformation_max);
+        }
+        write_file_atomic(out / "README.md", readme);
+        std::cout << "wrote " << (out / "README.md").string() << "\n";
+        return 0;
+      }};
+}
+
+}  // namespace skinlab::cli
