@@ -18,11 +18,6 @@ local:
 global: {type: global_pool, pool: [vertex], vertex_mlp: [512, 1024], to: [vertex], keep_input: false}
 )";
 
-const config::Config& defaults() {
-  static const config::Config c = config::Config::parse(kDefaults);
-  return c;
-}
-
 }  // namespace
 
 RigNetSkin::Options RigNetSkin::Options::from(const config::Node& node) {
@@ -33,7 +28,7 @@ RigNetSkin::Options RigNetSkin::Options::from(const config::Node& node) {
   f.optional("input_mlp", o.input_mlp);
   for (auto w : o.input_mlp) f.check(w >= 1, "input_mlp", "widths must be ≥ 1");
   f.finish();
-  o.fill_missing_branches(defaults());
+  o.fill_missing_branches(kDefaults);
   return o;
 }
 

@@ -26,11 +26,6 @@ local:
 global: {type: global_pool, vertex_mlp: [512], bone_mlp: [512], to: [vertex], keep_input: false}
 )";
 
-const config::Config& defaults() {
-  static const config::Config c = config::Config::parse(kDefaults);
-  return c;
-}
-
 }  // namespace
 
 HeterSkinNet::Options HeterSkinNet::Options::from(const config::Node& node) {
@@ -39,7 +34,7 @@ HeterSkinNet::Options HeterSkinNet::Options::from(const config::Node& node) {
   o.read(f);
   o.edge_dropout = graph::EdgeDropoutOptions::from(f.section("edge_dropout"));
   f.finish();
-  o.fill_missing_branches(defaults());
+  o.fill_missing_branches(kDefaults);
   return o;
 }
 

@@ -1,5 +1,8 @@
 #include "framework/models/branched_model.hpp"
 
+#include <map>
+#include <mutex>
+
 namespace skinlab::models {
 
 void BranchedModelOptions::read(config::Fields& f) {
@@ -18,10 +21,18 @@ void BranchedModelOptions::read(config::Fields& f) {
   f.check(head_dropout >= 0 && head_dropout < 1, "head_dropout", "must be in [0, 1)");
 }
 
-void BranchedModelOptions::fill_missing_branches(const config::Config& defaults) {
-  if (!stem.exists()) stem = defaults.root()["stem"];
-  if (!local.exists()) local = defaults.root()["local"];
-  if (!global.exists()) global = defaults.root()["global"];
+void BranchedModelOptions::fill_missing_branches(const char* defaults_yaml) {
+  static std::mutex mutex;
+  static std::map<const char*, config::Config> parsed;
+  const std::lock_guard<std::mutex> lock(mutex);
+  auto it = parsed.find(defaults_yaml);
+  if (it == parsed.end()) {
+    it = parsed.emplace(defaults_yaml, config::Config::parse(defaults_yaml)).first;
+  }
+  const config::Node root = it->second.root();
+  if (!stem.exists()) stem = root["stem"];
+  if (!local.exists()) local = root["local"];
+  if (!global.exists()) global = root["global"];
 }
 
 torch::Tensor inverse_distance(const torch::Tensor& topk_distance,

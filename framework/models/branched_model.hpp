@@ -35,8 +35,10 @@ struct BranchedModelOptions {
 
   /// Reads and checks these fields from `f` (call before `f.finish()`).
   void read(config::Fields& f);
-  /// Fills `stem`, `local` and `global` that the config left out from `defaults`' root.
-  void fill_missing_branches(const config::Config& defaults);
+  /// Fills `stem`, `local` and `global` that the config left out from the model's defaults,
+  /// `defaults_yaml` (a string literal with those three keys; parsed once per literal and kept
+  /// for the life of the program, so the filled nodes stay valid).
+  void fill_missing_branches(const char* defaults_yaml);
 };
 
 /// #V×K: 1 / max(D / distance_unit, min_distance) of the candidates' distances (#V×K metres).
