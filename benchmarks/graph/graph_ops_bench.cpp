@@ -128,6 +128,11 @@ void BM_B2v(benchmark::State& s) {
   const auto w = std::to_string(s.range(0));
   run(s, "{type: b2v, mlp: [" + w + "]}", s.range(0), kBoneWidth);
 }
+/// NeuroSkinning's graph convolution unit at its first unit's hidden width (x ‖ h ‖ pool(h)).
+void BM_GconvPool(benchmark::State& s) {
+  const auto w = std::to_string(s.range(0));
+  run(s, "{type: gconv_pool, mlp: [" + w + "]}", s.range(0), kBoneWidth);
+}
 void BM_GlobalPool(benchmark::State& s) {
   run(s, "{type: global_pool, vertex_mlp: [512], bone_mlp: [512]}", s.range(0), kBoneWidth);
 }
@@ -185,6 +190,7 @@ SKINLAB_GRAPH_BENCH(BM_EdgeConvSkeleton);
 SKINLAB_GRAPH_BENCH(BM_MeshConv);
 SKINLAB_GRAPH_BENCH(BM_V2b);
 SKINLAB_GRAPH_BENCH(BM_B2v);
+SKINLAB_GRAPH_BENCH(BM_GconvPool);
 SKINLAB_GRAPH_BENCH(BM_GlobalPool);
 BENCHMARK(BM_DropEdges)->Unit(benchmark::kMicrosecond);
 
