@@ -15,6 +15,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <numeric>
 
 #include "framework/cli/commands.hpp"
 #include "framework/core/atomic_file.hpp"
@@ -83,14 +84,15 @@ double percentile(std::vector<double> v, double q) {
   return v[k];
 }
 
-/// The smallest 1, 2 or 5 × 10^k at or above x (x > 0): a colour-bar maximum with short labels.
-double nice_ceiling(double x) {
-  const double p = std::pow(10.0, std::floor(std::log10(x)));
-  for (double m : {1.0, 2.0, 5.0, 10.0}) {
-    if (m * p >= x * (1 - 1e-12)) return m * p;
-  }
-  return 10 * p;
-}
+/// One kind of map of a character: file suffix, PLY property, decimals of the means in the
+/// README, colour-scale top, values (one vector per run) and caption (`{}`: the scale top).
+struct ErrorMap {
+  std::string suffix, property;
+  int decimals;
+  double vmax;
+  const std::vector<std::vector<double>>* values;
+  std::string caption;
+};
 
 /// One map's figure: a column per run (front view above the side view), a colour bar below.
 report::Image panel(const data::PreparedCharacter& c,
@@ -187,49 +189,37 @@ Command add_figure(CLI::App& app) {
             l1.emplace_back(e.data(), e.data() + e.size());
             const Eigen::VectorXd d = r.deformation->vertex_distances(in).colwise().mean();
             deformation.emplace_back(d.data(), d.data() + d.size());
-            const fs::path folder = out / r.experiment;
-            fs::create_directories(folder);
-            const std::string comment =
-                fmt::format("{} {} part {}", r.dir.string(), name, args->part);
-            report::write_coloured_ply(folder / (name + "_l1.ply"), it->V, it->F,
-                                       report::colour_values(l1.back(), args->l1_max), "l1_error",
-                                       l1.back(), comment);
+            fs::create_directories(out / r.experiment);
           }
           std::vector<double> all;
           for (const auto& d : deformation) all.insert(all.end(), d.begin(), d.end());
-          const double deformation_max = nice_ceiling(std::max(percentile(all, 0.99), 1e-6));
-          for (std::size_t i = 0; i < runs.size(); ++i) {
-            report::write_coloured_ply(
-                out / runs[i].experiment / (name + "_deformation.ply"), character->V, character->F,
-                report::colour_values(deformation[i], deformation_max), "deformation_error",
-                deformation[i], runs[i].dir.string() + " " + name);
-          }
-          report::write_png(out / (name + "_l1.png"), panel(*character, l1, args->l1_max));
-          report::write_png(out / (name + "_deformation.png"),
-                            panel(*character, deformation, deformation_max));
+          const double deformation_max =
+              report::nice_width(std::max(percentile(all, 0.99), 1e-6), 1);
+          const std::vector<ErrorMap> maps = {
+              {"l1", "l1_error", 4, args->l1_max, &l1,
+               "per-vertex L1 error Σ_b |P − G| of the pruned predicted bone weights against the "
+               "artist weights, scale 0 – {}."},
+              {"deformation", "deformation_error", 6, deformation_max, &deformation,
+               "per-vertex deformation error (distance between the vertex skinned with the "
+               "predicted and with the artist weights, mean over the evaluation poses), scale 0 "
+               "– {} m of the 1 m-tall normalised character."}};
           readme += fmt::format("## {}\n\n", name);
-          readme += fmt::format(
-              "![L1]({0}_l1.png)\n\n`{0}_l1.png`: per-vertex L1 error Σ_b |P − G| of the "
-              "pruned predicted bone weights against the artist weights, scale 0 – {1}. "
-              "Means:",
-              name, args->l1_max);
-          for (std::size_t i = 0; i < runs.size(); ++i) {
-            double s = 0;
-            for (double v : l1[i]) s += v;
-            readme += fmt::format(" {} {:.4f};", runs[i].experiment, s / l1[i].size());
+          for (const ErrorMap& map : maps) {
+            const std::string png = name + "_" + map.suffix + ".png";
+            report::write_png(out / png, panel(*character, *map.values, map.vmax));
+            readme += fmt::format("![{}]({})\n\n`{}`: ", map.suffix, png, png) +
+                      fmt::format(fmt::runtime(map.caption), map.vmax) + " Means:";
+            for (std::size_t i = 0; i < runs.size(); ++i) {
+              const std::vector<double>& v = (*map.values)[i];
+              report::write_coloured_ply(
+                  out / runs[i].experiment / (name + "_" + map.suffix + ".ply"), character->V,
+                  character->F, report::colour_values(v, map.vmax), map.property, v,
+                  fmt::format("{} {} part {}", runs[i].dir.string(), name, args->part));
+              const double mean = std::accumulate(v.begin(), v.end(), 0.0) / v.size();
+              readme += fmt::format(" {} {:.{}f};", runs[i].experiment, mean, map.decimals);
+            }
+            readme += "\n\n";
           }
-          readme += fmt::format(
-              "\n\n![deformation]({0}_deformation.png)\n\n`{0}_deformation.png`: per-vertex "
-              "deformation error (distance between the vertex skinned with the predicted and "
-              "with the artist weights, mean over the evaluation poses), scale 0 – {1} m of "
-              "the 1 m-tall normalised character. Means:",
-              name, deformation_max);
-          for (std::size_t i = 0; i < runs.size(); ++i) {
-            double s = 0;
-            for (double v : deformation[i]) s += v;
-            readme += fmt::format(" {} {:.6f};", runs[i].experiment, s / deformation[i].size());
-          }
-          readme += "\n\n";
           std::cout << fmt::format(
               "{}: wrote {}_l1.png and {}_deformation.png (deformation "
               "scale 0 - {} m)\n",

@@ -149,20 +149,12 @@ Image compose_row(const std::vector<Image>& images, int gap, const Image* below)
   const bool has_below = below != nullptr && below->width > 0 && below->height > 0;
   if (has_below) width = std::max(width, below->width);
   Image out(std::max(width, 1), std::max(height + (has_below ? gap + below->height : 0), 1));
-  auto paste = [&out](const Image& im, int x0, int y0) {
-    for (int y = 0; y < im.height; ++y) {
-      for (int x = 0; x < im.width; ++x) {
-        const std::size_t i = 3 * (static_cast<std::size_t>(y) * im.width + x);
-        out.set(x0 + x, y0 + y, {im.pixels[i], im.pixels[i + 1], im.pixels[i + 2]});
-      }
-    }
-  };
   int x = 0;
   for (const Image& im : images) {
-    paste(im, x, 0);
+    out.paste(im, x, 0);
     x += im.width + gap;
   }
-  if (has_below) paste(*below, (width - below->width) / 2, height + gap);
+  if (has_below) out.paste(*below, (width - below->width) / 2, height + gap);
   return out;
 }
 
@@ -175,10 +167,7 @@ Image compose_column(const std::vector<Image>& rows, int gap) {
   Image out(std::max(width, 1), std::max(height, 1));
   int y0 = 0;
   for (const Image& im : rows) {
-    for (int y = 0; y < im.height; ++y) {
-      std::copy_n(im.pixels.begin() + 3 * static_cast<std::ptrdiff_t>(y) * im.width, 3 * im.width,
-                  out.pixels.begin() + 3 * (static_cast<std::ptrdiff_t>(y0 + y) * out.width));
-    }
+    out.paste(im, 0, y0);
     y0 += im.height + gap;
   }
   return out;

@@ -62,16 +62,6 @@ void chunk(std::string& out, const char* type, const std::string& data) {
                                                 static_cast<uInt>(body.size()))));
 }
 
-/// 1, 2 or 5 × 10^k closest above range / bins.
-double nice_width(double range, int bins) {
-  const double raw = std::max(range, 1e-12) / std::max(bins, 1);
-  const double p = std::pow(10.0, std::floor(std::log10(raw)));
-  for (double m : {1.0, 2.0, 5.0, 10.0}) {
-    if (m * p >= raw) return m * p;
-  }
-  return 10 * p;
-}
-
 std::string label(double v) {
   if (std::abs(v) >= 10000 && std::fmod(v, 1000) == 0)
     return std::to_string(static_cast<long long>(v / 1000)) + "k";
@@ -82,6 +72,15 @@ std::string label(double v) {
 }
 
 }  // namespace
+
+double nice_width(double range, int bins) {
+  const double raw = std::max(range, 1e-12) / std::max(bins, 1);
+  const double p = std::pow(10.0, std::floor(std::log10(raw)));
+  for (double m : {1.0, 2.0, 5.0, 10.0}) {
+    if (m * p >= raw) return m * p;
+  }
+  return 10 * p;
+}
 
 Image::Image(int w, int h, Rgb background) : width(w), height(h) {
   if (w <= 0 || h <= 0) throw std::invalid_argument("Image: size must be positive");
@@ -95,6 +94,15 @@ Image::Image(int w, int h, Rgb background) : width(w), height(h) {
 void Image::set(int x, int y, Rgb c) {
   if (x < 0 || y < 0 || x >= width || y >= height) return;
   std::copy(c.begin(), c.end(), pixels.begin() + (static_cast<std::ptrdiff_t>(y) * width + x) * 3);
+}
+
+void Image::paste(const Image& image, int x0, int y0) {
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      const std::size_t i = 3 * (static_cast<std::size_t>(y) * image.width + x);
+      set(x0 + x, y0 + y, {image.pixels[i], image.pixels[i + 1], image.pixels[i + 2]});
+    }
+  }
 }
 
 void Image::fill_rect(int x0, int y0, int x1, int y1, Rgb c) {
@@ -279,8 +287,10 @@ Image line_plot(const std::vector<Series>& series, const LinePlotOptions& o) {
         continue;
       }
       const int x = px(s.x[i]), y = py(s.y[i]);
-      if (have) draw_line(img, last_x, last_y, x, y, s.colour);
-      else img.fill_rect(x - 1, y - 1, x + 1, y + 1, s.colour);
+      if (have)
+        draw_line(img, last_x, last_y, x, y, s.colour);
+      else
+        img.fill_rect(x - 1, y - 1, x + 1, y + 1, s.colour);
       have = true, last_x = x, last_y = y;
     }
   }

@@ -24,11 +24,17 @@ struct Image {
   Image(int w, int h, Rgb background = {255, 255, 255});
   void set(int x, int y, Rgb c);                          ///< ignores pixels outside the image
   void fill_rect(int x0, int y0, int x1, int y1, Rgb c);  ///< inclusive corners, clipped
+  /// Copies `image` with its top-left corner at (x0, y0); pixels outside this image are dropped.
+  void paste(const Image& image, int x0, int y0);
   /// Draws `text` (digits, '.', '-', '+', 'k', 'M', '%', ' ') with its top-left corner at
   /// (x, y), each font pixel `scale`×`scale`. Other characters throw std::invalid_argument.
   void text(int x, int y, const std::string& text, int scale, Rgb c);
   static int text_width(const std::string& text, int scale);
 };
+
+/// The 1, 2 or 5 × 10^k closest at or above range / bins: an axis step, or with bins = 1 a
+/// scale maximum with short labels.
+double nice_width(double range, int bins);
 
 /// Encodes `image` as PNG bytes.
 std::string encode_png(const Image& image);
