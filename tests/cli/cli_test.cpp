@@ -219,6 +219,63 @@ TEST(Cli, TrainAndEvalReportBadInputsBeforeCreatingARun) {
 
 // What CI runs of the main job's path: configs/smoke.yaml (HeterSkinNet with tiny widths) on the
 // bundled real 0 A.D. subset, prepared here, trained and evaluated through the binary.
+/// configs/sweeps/smoke_table3.yaml on a prepared bundled subset `data`: every method of Table 3
+/// (the learned baselines with tiny widths) trains or runs, is evaluated on the same test
+/// characters and gets a row with finite metrics in the table, with an ANOVA row against the
+/// first entry.
+void check_smoke_table3(const TempDir& dir, const std::string& data, const std::string& results) {
+  std::string sweep = read_file(std::filesystem::path(SKINLAB_SOURCE_DIR) / "configs" / "sweeps" /
+                                "smoke_table3.yaml");
+  const std::string out_line = "out: results/tables/smoke_table3.md";
+  const auto at = sweep.find(out_line);
+  ASSERT_NE(at, std::string::npos) << sweep;
+  const std::filesystem::path table_md = dir / "tables" / "smoke_table3.md";
+  sweep.replace(at, out_line.size(), "out: " + table_md.string());
+  sweep += "overrides: [data.file=" + data + ", results_dir=" + results + "]\n";
+  const Result s = run("sweep " + dir.write("smoke_table3.yaml", sweep).string());
+  ASSERT_EQ(s.status, 0) << s.err;
+  const std::string table = read_file(table_md);
+  std::vector<double> avg_l1;
+  for (const std::string experiment :
+       {"smoke", "rignet_skin_smoke", "neuroskinning_smoke", "geo_voxel_smoke", "bone_heat_smoke"}) {
+    EXPECT_NE(table.find("| " + experiment + " | smoke_table3 | "), std::string::npos)
+        << experiment << "\n" << table;
+    const std::filesystem::path run_dir = std::filesystem::path(results) / experiment / "smoke_table3";
+    const auto report = nlohmann::json::parse(read_file(run_dir / "eval_test.json"));
+    EXPECT_EQ(report["per_character"].size(), 3u) << experiment;
+    for (const char* key : {"precision", "recall", "avg_l1", "deformation_error"}) {
+      const double value = report["mean"][key].get<double>();
+      EXPECT_TRUE(std::isfinite(value)) << experiment << " " << key;
+      EXPECT_GE(value, 0.0) << experiment << " " << key;
+    }
+    EXPECT_GT(report["mean"]["precision"].get<double>(), 0.0) << experiment;
+    EXPECT_LE(report["mean"]["precision"].get<double>(), 1.0) << experiment;
+    EXPECT_LE(report["mean"]["recall"].get<double>(), 1.0) << experiment;
+    // Σ_b |P − G| of two distributions lies in [0, 2].
+    EXPECT_LE(report["mean"]["avg_l1"].get<double>(), 2.0) << experiment;
+    avg_l1.push_back(report["mean"]["avg_l1"].get<double>());
+    const bool learned = experiment.find("voxel") == std::string::npos &&
+                         experiment.find("heat") == std::string::npos;
+    EXPECT_EQ(std::filesystem::exists(run_dir / "best.pt"), learned) << experiment;
+    if (learned) {
+      std::ifstream lines(run_dir / "metrics.jsonl");
+      int epochs = 0;
+      for (std::string line; std::getline(lines, line);) {
+        const auto epoch = nlohmann::json::parse(line);
+        EXPECT_TRUE(std::isfinite(epoch["train_loss"].get<double>())) << experiment;
+        EXPECT_TRUE(std::isfinite(epoch["val_loss"].get<double>())) << experiment;
+        ++epochs;
+      }
+      EXPECT_GE(epochs, 2) << experiment;
+    }
+  }
+  // Five different methods give five different predictions.
+  std::sort(avg_l1.begin(), avg_l1.end());
+  EXPECT_EQ(std::adjacent_find(avg_l1.begin(), avg_l1.end()), avg_l1.end());
+  EXPECT_NE(table.find("| One-way ANOVA vs smoke |"), std::string::npos) << table;
+  EXPECT_NE(table.find("| bone_heat_smoke | "), std::string::npos) << table;
+}
+
 TEST(Cli, SmokeRunPrepareTrainEvalOnTheBundledSubset) {
   TempDir dir;
   const std::string data = (dir / "bundled.h5").string();
@@ -328,6 +385,8 @@ TEST(Cli, SmokeRunPrepareTrainEvalOnTheBundledSubset) {
   const Result t2 = run("sweep " + twice.string());
   EXPECT_EQ(t2.status, 1);
   EXPECT_NE(t2.err.find("would share the run directory"), std::string::npos) << t2.err;
+
+  check_smoke_table3(dir, data, results);
 }
 
 }  // namespace
