@@ -1,6 +1,7 @@
 #include "framework/data/preprocess.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <limits>
 #include <numeric>
 
@@ -116,10 +117,18 @@ AnimationData convert(const datasets::Animation& a, const Eigen::Matrix4d& sim, 
 
 PreparedCharacter preprocess(const datasets::SourceCharacter& source,
                              const std::vector<NamedDistance>& distances,
-                             const PreprocessOptions& options) {
+                             const PreprocessOptions& options, const PreprocessMode& mode,
+                             PreprocessTimes* times) {
+  using Clock = std::chrono::steady_clock;
+  auto lap = [last = Clock::now()](double* into) mutable {
+    const auto now = Clock::now();
+    if (into != nullptr) *into += std::chrono::duration<double>(now - last).count();
+    last = now;
+  };
   geometry::Character c = source.character;
   const std::string where = c.name + " (" + source.path + ")";
-  if (!c.has_weights()) throw Error(where + ": character has no skin weights");
+  const bool weighted = c.has_weights();
+  if (!weighted && mode.require_weights) throw Error(where + ": character has no skin weights");
 
   // 1. Normalise.
   geometry::NormalizeOptions normalize_options;
@@ -129,14 +138,20 @@ PreparedCharacter preprocess(const datasets::SourceCharacter& source,
   // 2. Merge co-located vertices; average their weights.
   const geometry::MergedMesh merged = geometry::merge_vertices(c.mesh, {options.merge_tolerance});
   const geometry::SparseWeights W_merged =
-      geometry::average_vertex_data(c.weights, merged.old_to_new, merged.mesh.num_vertices());
+      weighted ? geometry::average_vertex_data(c.weights, merged.old_to_new,
+                                               merged.mesh.num_vertices())
+               : geometry::SparseWeights();
 
   // 3. Subdivide small meshes; interpolate weights linearly.
   const geometry::SubdividedMesh sub =
       geometry::subdivide(merged.mesh, {options.min_vertices, options.max_vertices});
-  geometry::SparseWeights W = (sub.S * W_merged).pruned();
-  W.makeCompressed();
+  geometry::SparseWeights W;
+  if (weighted) {
+    W = (sub.S * W_merged).pruned();
+    W.makeCompressed();
+  }
   const geometry::Mesh& mesh = sub.mesh;
+  lap(times != nullptr ? &times->normalise : nullptr);
 
   PreparedCharacter out;
   out.name = c.name;
@@ -167,8 +182,12 @@ PreparedCharacter preprocess(const datasets::SourceCharacter& source,
     // file agree with the stored top-K and targets.
     const Eigen::MatrixXd Ds = d.D.cast<double>();
     top_k_bones(Ds, options.top_k, d.topk_index, d.topk_distance);
+    d.targets = RowMatrixXf::Zero(D.rows(), d.topk_index.cols());
+    if (!weighted) {
+      out.distances.emplace(named.type, std::move(d));
+      continue;
+    }
     const Eigen::MatrixXd Wb = bone_weights(W, c.skeleton, Ds);
-    d.targets.resize(D.rows(), d.topk_index.cols());
     for (Eigen::Index v = 0; v < D.rows(); ++v) {
       for (Eigen::Index k = 0; k < d.topk_index.cols(); ++k) {
         d.targets(v, k) = static_cast<float>(Wb(v, d.topk_index(v, k)));
@@ -177,13 +196,16 @@ PreparedCharacter preprocess(const datasets::SourceCharacter& source,
     out.distances.emplace(named.type, std::move(d));
   }
 
+  lap(times != nullptr ? &times->distance : nullptr);
+
   // 5. Graph structure and the Laplacian.
   out.one_ring_edges = edge_rows(geometry::one_ring(mesh).edges);
   geometry::GeodesicOptions geo;
   geo.radius = options.geodesic_radius;
   geo.max_neighbours = options.geodesic_max_neighbours;
   out.geodesic_edges = edge_rows(geometry::geodesic_neighbours(mesh, geo).edges);
-  const Eigen::SparseMatrix<double, Eigen::RowMajor> L = geometry::laplacian(mesh);
+  Eigen::SparseMatrix<double, Eigen::RowMajor> L(mesh.num_vertices(), mesh.num_vertices());
+  if (mode.laplacian) L = geometry::laplacian(mesh);
   out.laplacian_indices.resize(L.nonZeros(), 2);
   out.laplacian_values.reserve(L.nonZeros());
   Eigen::Index n = 0;
@@ -193,6 +215,7 @@ PreparedCharacter preprocess(const datasets::SourceCharacter& source,
       out.laplacian_values.push_back(it.value());
     }
   }
+  lap(times != nullptr ? &times->graph : nullptr);
 
   out.source = source.source;
   out.path = source.path;

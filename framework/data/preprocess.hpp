@@ -63,10 +63,27 @@ void top_k_bones(const Eigen::MatrixXd& D, int k, RowMatrixXi& index, RowMatrixX
 Eigen::MatrixXd bone_weights(const geometry::SparseWeights& W, const geometry::Skeleton& skeleton,
                              const Eigen::MatrixXd& D);
 
-/// Runs steps 1–5 on `source` (which must carry weights). Throws (GeometryError, IoError) with
-/// the character's name in the message when any step fails.
+/// What `preprocess` is asked to do beyond the dataset defaults, for `skinlab predict`.
+struct PreprocessMode {
+  /// false: a character without weights is prepared too (empty `weights`, zero `targets`), as a
+  /// character to predict for; true: one without weights is an error (a training character).
+  bool require_weights = true;
+  bool laplacian = true;  ///< step 5's Laplacian (only the smoothing loss needs it)
+};
+
+/// Wall-clock seconds of the steps of one `preprocess` call.
+struct PreprocessTimes {
+  double normalise = 0;  ///< steps 1–3: normalise, merge, subdivide
+  double distance = 0;   ///< step 4: distances, top-K and targets
+  double graph = 0;      ///< step 5: one-ring and geodesic edges, Laplacian
+};
+
+/// Runs steps 1–5 on `source` (which must carry weights unless `mode.require_weights` is
+/// false). Throws (GeometryError, IoError) with the character's name in the message when any
+/// step fails. `times`, when given, receives the time of each step.
 PreparedCharacter preprocess(const datasets::SourceCharacter& source,
                              const std::vector<NamedDistance>& distances,
-                             const PreprocessOptions& options = {});
+                             const PreprocessOptions& options = {},
+                             const PreprocessMode& mode = {}, PreprocessTimes* times = nullptr);
 
 }  // namespace skinlab::data

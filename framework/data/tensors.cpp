@@ -76,11 +76,16 @@ CharacterTensors to_tensors(const PreparedCharacter& character, const std::strin
   if (!same_bones) {
     throw IoError(where + ": the stored bones are not the skeleton's bones in RigNet's order");
   }
-  if (character.weights.rows() != nv || character.weights.cols() != character.num_joints()) {
-    throw IoError(where + ": weights are not #V×#J");
+  if (character.weights.rows() == 0 && character.weights.cols() == 0) {
+    // A character prepared for prediction (preprocess.hpp, PreprocessMode): no ground truth.
+    t.bone_weights = torch::Tensor();
+  } else {
+    if (character.weights.rows() != nv || character.weights.cols() != character.num_joints()) {
+      throw IoError(where + ": weights are not #V×#J");
+    }
+    const Eigen::MatrixXd Wb = bone_weights(character.weights, skeleton, d.D.cast<double>());
+    t.bone_weights = to_float(RowMatrixXd(Wb));
   }
-  const Eigen::MatrixXd Wb = bone_weights(character.weights, skeleton, d.D.cast<double>());
-  t.bone_weights = to_float(RowMatrixXd(Wb));
 
   RowMatrixXd segments(nb, 6);
   for (Eigen::Index b = 0; b < nb; ++b) {

@@ -34,7 +34,9 @@ struct CharacterTensors {
   /// renormalised per row (weight outside the K candidates is dropped, Sec. 3.2); a row whose
   /// candidates carry no weight at all stays all-zero.
   torch::Tensor targets;
-  torch::Tensor bone_weights;  ///< #V×#B float32 full ground-truth bone weights, rows sum to 1
+  /// #V×#B float32 full ground-truth bone weights, rows sum to 1; undefined for a character
+  /// prepared without weights (for prediction)
+  torch::Tensor bone_weights;
   torch::Tensor bones;         ///< #B×6 float32 bone attribute [start xyz, end xyz] (Sec. 3.2)
   torch::Tensor bone_joints;   ///< #B×2 int64 (start, end) joint of each bone
   torch::Tensor one_ring;      ///< #E×2 int64 mesh edges (N_m of Eq. 2)

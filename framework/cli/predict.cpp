@@ -1,0 +1,204 @@
+/// \file
+/// `skinlab predict <input> [--rig rig.txt] [--model DIR] --out FILE [--out FILE ...]`: skin
+/// weights for one character with a trained model (framework/predict/predictor.hpp), written in
+/// the input's own frame, vertex order and joint names:
+///
+///     .glb / .gltf   glTF 2.0 skin (geometry/gltf_export.hpp): joints, inverse bind matrices,
+///                    JOINTS_0/WEIGHTS_0 with each vertex's 4 largest weights renormalised
+///     _rig.txt       RigNet rig text (geometry/rig_io.hpp): every kept weight
+///     .h5            the full #V×#B bone weights and #V×#J joint weights (file comment below)
+///
+/// Input: an OBJ with `--rig` (RigNet rig text; its `skin` lines, if any, are the ground truth),
+/// or one file assimp reads with a skeleton (FBX, glTF/GLB, DAE, IQM, B3D, ...). Weights in the
+/// input are ignored by the prediction; with `--compare-to-input` the model's metrics
+/// (HeterSkinNet Sec. 4.3) against them are printed. Every output is checked before any work
+/// starts and written whole (atomic rename), so a failure never leaves a partial file.
+///
+/// HDF5 layout: /weights (#V×#B float32, bones in RigNet's order), /joint_weights (#V×#J),
+/// /bones (#B×2 start, end joints), /joint_names, /vertices (#V×3, input frame); attributes
+/// model, distance, prune, character.
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <iostream>
+
+#include "framework/cli/commands.hpp"
+#include "framework/core/environment.hpp"
+#include "framework/core/error.hpp"
+#include "framework/data/h5.hpp"
+#include "framework/eval/predictions.hpp"
+#include "framework/geometry/gltf_export.hpp"
+#include "framework/geometry/load_character.hpp"
+#include "framework/geometry/rig_io.hpp"
+#include "framework/geometry/vertex_normals.hpp"
+#include "framework/predict/predictor.hpp"
+
+namespace skinlab::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct PredictArgs {
+  std::string input;
+  std::string rig;
+  std::string model;
+  std::string checkpoint = "best";
+  std::vector<std::string> out;
+  double prune = 0.25;
+  std::string up = "y";
+  bool compare = false;
+  bool timings = false;
+};
+
+enum class OutputKind { gltf, rig, h5 };
+
+OutputKind output_kind(const fs::path& out) {
+  const std::string name = out.filename().string();
+  const std::string ext = out.extension().string();
+  if (ext == ".glb" || ext == ".gltf") return OutputKind::gltf;
+  if (ext == ".h5" || ext == ".hdf5") return OutputKind::h5;
+  if (ext == ".txt") return OutputKind::rig;
+  throw Error(out.string() + ": unknown output type '" + ext +
+              "' (use .glb, .gltf, _rig.txt or .h5)");
+}
+
+/// The default model: the bundled one of the source tree.
+fs::path default_model() { return source_dir() / "results" / "bundled" / "heterskinnet"; }
+
+Eigen::Vector3d up_axis(const std::string& up) {
+  if (up == "y") return Eigen::Vector3d::UnitY();
+  if (up == "z") return Eigen::Vector3d::UnitZ();
+  throw Error("--up must be y or z, got '" + up + "'");
+}
+
+void write_h5(const fs::path& out, const geometry::Character& input,
+              const predict::Prediction& p, const predict::Predictor& predictor, double prune) {
+  data::H5Writer w(out);
+  w.write("weights", p.source_weights);
+  w.write("joint_weights", data::RowMatrixXd(Eigen::MatrixXd(p.joint_weights)));
+  w.write("bones", p.prepared.bones);
+  w.write_strings("joint_names", input.skeleton.names);
+  w.write("vertices", data::RowMatrixXd(input.mesh.V));
+  w.write_attribute("model", predictor.description());
+  w.write_attribute("distance", predictor.distance());
+  w.write_attribute("prune", fmt::format("{}", prune));
+  w.write_attribute("character", input.name);
+  w.commit();
+}
+
+int run(const PredictArgs& args) {
+  using Clock = std::chrono::steady_clock;
+  if (args.out.empty()) throw Error("predict: give at least one --out file");
+  for (const auto& out : args.out) output_kind(out);  // before any work
+  const Eigen::Vector3d up = up_axis(args.up);
+
+  const fs::path model_dir = args.model.empty() ? default_model() : fs::path(args.model);
+  const predict::Predictor predictor = predict::Predictor::load(model_dir, args.checkpoint);
+  spdlog::info("model: {}", predictor.description());
+
+  predict::StageTimes times;
+  auto start = Clock::now();
+  geometry::Character input = geometry::load_character(args.input, args.rig);
+  times.load = std::chrono::duration<double>(Clock::now() - start).count();
+  if (args.compare && !input.has_weights()) {
+    throw Error(args.input + ": --compare-to-input, but the input carries no skin weights");
+  }
+  predict::PredictOptions options;
+  options.prune = args.prune;
+  options.up = up;
+  const predict::Prediction p = predictor.predict(input, options, &times);
+
+  if (args.compare) {
+    const auto values = predictor.compare(p);
+    std::cout << fmt::format("{} against the input's weights:", input.name);
+    for (const auto& [name, value] : values) std::cout << fmt::format(" {} {:.4f}", name, value);
+    std::cout << "\n";
+  }
+
+  start = Clock::now();
+  geometry::Character result;
+  result.name = input.name;
+  result.mesh = input.mesh;
+  result.skeleton = input.skeleton;
+  result.weights = p.joint_weights;
+  for (const auto& out : args.out) {
+    switch (output_kind(out)) {
+      case OutputKind::gltf: {
+        geometry::GltfExportOptions gltf;
+        gltf.normals = geometry::vertex_normals(input.mesh);
+        geometry::write_gltf(out, result, gltf);
+        break;
+      }
+      case OutputKind::rig: {
+        geometry::Skeleton named = eval::source_skeleton(p.prepared);
+        named.positions = input.skeleton.positions;
+        geometry::write_rig(out, named, p.joint_weights);
+        break;
+      }
+      case OutputKind::h5:
+        write_h5(out, input, p, predictor, args.prune);
+        break;
+    }
+    std::cout << "wrote " << out << "\n";
+  }
+  times.export_ = std::chrono::duration<double>(Clock::now() - start).count();
+
+  std::cout << fmt::format("{}: {} vertices ({} prepared), {} joints, {} bones; {:.3f} s\n",
+                           input.name, input.mesh.num_vertices(), p.prepared.num_vertices(),
+                           input.skeleton.num_joints(), p.prepared.num_bones(), times.total());
+  if (args.timings) {
+    std::cout << fmt::format(
+        "stages (s): load {:.4f}, normalise {:.4f}, distance {:.4f}, graph {:.4f}, network "
+        "{:.4f}, map back {:.4f}, export {:.4f}\n",
+        times.load, times.normalise, times.distance, times.graph, times.network, times.map_back,
+        times.export_);
+  }
+  return 0;
+}
+
+}  // namespace
+
+Command add_predict(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "predict", "skin weights for one character with a trained model (glTF, rig text, HDF5)");
+  auto args = std::make_shared<PredictArgs>();
+  cmd->add_option("input", args->input,
+                  "character file (FBX, glTF/GLB, DAE, IQM, B3D, ... or OBJ with --rig)")
+      ->required();
+  cmd->add_option("--rig", args->rig, "RigNet rig text file of an OBJ mesh (its skeleton)");
+  cmd->add_option("--model", args->model,
+                  "run directory or bundled model (default: results/bundled/heterskinnet)");
+  cmd->add_option("--checkpoint", args->checkpoint, "best or last (run directories)")
+      ->capture_default_str();
+  cmd->add_option("--out", args->out, "output file: .glb, .gltf, _rig.txt or .h5 (repeatable)")
+      ->required();
+  cmd->add_option("--prune", args->prune,
+                  "drop weights below this fraction of the row maximum (HeterSkinNet Sec. 4.5)")
+      ->capture_default_str();
+  cmd->add_option("--up", args->up, "up axis of the input, y or z")->capture_default_str();
+  cmd->add_flag("--compare-to-input", args->compare,
+                "print the metrics against the weights the input carries");
+  cmd->add_flag("--timings", args->timings, "print the time of every stage");
+  return {cmd, [args] { return run(*args); }};
+}
+
+Command add_bundle(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "bundle", "a self-contained model directory for skinlab predict from a trained run");
+  auto run_dir = std::make_shared<std::string>();
+  auto out = std::make_shared<std::string>();
+  auto checkpoint = std::make_shared<std::string>("best");
+  cmd->add_option("run", *run_dir, "run directory of skinlab train")->required();
+  cmd->add_option("--out", *out, "new directory, e.g. results/bundled/heterskinnet")->required();
+  cmd->add_option("--checkpoint", *checkpoint, "best or last")->capture_default_str();
+  return {cmd, [run_dir, out, checkpoint] {
+            predict::bundle(*run_dir, *out, *checkpoint);
+            std::cout << "wrote " << *out << "\n";
+            return 0;
+          }};
+}
+
+}  // namespace skinlab::cli

@@ -1,0 +1,235 @@
+#include "framework/geometry/gltf_export.hpp"
+
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <cstring>
+#include <limits>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+#include "framework/core/atomic_file.hpp"
+#include "framework/core/error.hpp"
+
+namespace skinlab::geometry {
+
+namespace {
+
+/// Appends `bytes` to buffer 0 as a new buffer view (4-byte aligned, as accessors of 4-byte
+/// components need) and an accessor over it; returns the accessor index.
+int add_accessor(tinygltf::Model& model, const void* data, std::size_t bytes, int component_type,
+                 int type, std::size_t count, int target) {
+  auto& buffer = model.buffers[0].data;
+  while (buffer.size() % 4 != 0) buffer.push_back(0);
+  tinygltf::BufferView view;
+  view.buffer = 0;
+  view.byteOffset = buffer.size();
+  view.byteLength = bytes;
+  view.target = target;
+  const auto* p = static_cast<const unsigned char*>(data);
+  buffer.insert(buffer.end(), p, p + bytes);
+  model.bufferViews.push_back(view);
+
+  tinygltf::Accessor accessor;
+  accessor.bufferView = static_cast<int>(model.bufferViews.size()) - 1;
+  accessor.componentType = component_type;
+  accessor.type = type;
+  accessor.count = count;
+  model.accessors.push_back(accessor);
+  return static_cast<int>(model.accessors.size()) - 1;
+}
+
+/// The kept influences of every vertex: the largest `max_influences` weights of its row of W
+/// (#V×#J), renormalised, as (joint, weight) pairs, largest first.
+std::vector<std::vector<std::pair<int, float>>> kept_influences(const SparseWeights& W,
+                                                                 int max_influences,
+                                                                 const std::string& where) {
+  std::vector<std::vector<std::pair<int, float>>> out(static_cast<std::size_t>(W.rows()));
+  for (Eigen::Index v = 0; v < W.rows(); ++v) {
+    std::vector<std::pair<int, double>> row;
+    for (SparseWeights::InnerIterator it(W, v); it; ++it) {
+      if (it.value() > 0) row.emplace_back(static_cast<int>(it.col()), it.value());
+    }
+    if (row.empty()) throw Error(where + ": vertex " + std::to_string(v) + " has no weight");
+    std::sort(row.begin(), row.end(), [](const auto& a, const auto& b) {
+      return a.second != b.second ? a.second > b.second : a.first < b.first;
+    });
+    if (static_cast<int>(row.size()) > max_influences) row.resize(max_influences);
+    double sum = 0;
+    for (const auto& [j, w] : row) sum += w;
+    auto& kept = out[static_cast<std::size_t>(v)];
+    for (const auto& [j, w] : row) kept.emplace_back(j, static_cast<float>(w / sum));
+  }
+  return out;
+}
+
+}  // namespace
+
+void write_gltf(const std::filesystem::path& file, const Character& character,
+                const GltfExportOptions& options) {
+  const std::string where = file.string();
+  const std::string ext = file.extension().string();
+  if (ext != ".glb" && ext != ".gltf") {
+    throw Error(where + ": unknown glTF extension '" + ext + "' (use .glb or .gltf)");
+  }
+  if (options.max_influences < 1 || options.max_influences > 8) {
+    throw Error(where + ": max_influences must be in 1..8, got " +
+                std::to_string(options.max_influences));
+  }
+  const Mesh& mesh = character.mesh;
+  const Skeleton& skeleton = character.skeleton;
+  const int nv = mesh.num_vertices();
+  const int nj = skeleton.num_joints();
+  if (!character.has_weights()) {
+    throw Error(where + ": character '" + character.name + "' has no weights");
+  }
+  if (character.weights.rows() != nv || character.weights.cols() != nj) {
+    throw Error(where + ": weights are " + std::to_string(character.weights.rows()) + "×" +
+                std::to_string(character.weights.cols()) + ", expected #V×#J = " +
+                std::to_string(nv) + "×" + std::to_string(nj));
+  }
+  if (options.normals.rows() != 0 && options.normals.rows() != nv) {
+    throw Error(where + ": " + std::to_string(options.normals.rows()) + " normals for " +
+                std::to_string(nv) + " vertices");
+  }
+
+  tinygltf::Model model;
+  model.asset.version = "2.0";
+  model.asset.generator = "skinlab";
+  model.buffers.emplace_back();
+
+  // Joints: node j is joint j, translated from its parent.
+  const auto children = skeleton.children();
+  for (int j = 0; j < nj; ++j) {
+    tinygltf::Node node;
+    node.name = skeleton.names[j];
+    const int p = skeleton.parents[j];
+    const Eigen::Vector3d local = p < 0 ? Eigen::Vector3d(skeleton.positions.row(j))
+                                        : Eigen::Vector3d(skeleton.positions.row(j) -
+                                                          skeleton.positions.row(p));
+    node.translation = {local.x(), local.y(), local.z()};
+    node.children.assign(children[j].begin(), children[j].end());
+    model.nodes.push_back(std::move(node));
+  }
+
+  // Geometry.
+  std::vector<float> positions(static_cast<std::size_t>(nv) * 3);
+  std::vector<double> lo(3, std::numeric_limits<double>::infinity());
+  std::vector<double> hi(3, -std::numeric_limits<double>::infinity());
+  for (int v = 0; v < nv; ++v) {
+    for (int a = 0; a < 3; ++a) {
+      const float x = static_cast<float>(mesh.V(v, a));
+      positions[static_cast<std::size_t>(v) * 3 + a] = x;
+      lo[a] = std::min(lo[a], static_cast<double>(x));
+      hi[a] = std::max(hi[a], static_cast<double>(x));
+    }
+  }
+  tinygltf::Primitive primitive;
+  primitive.mode = TINYGLTF_MODE_TRIANGLES;
+  const int position_accessor =
+      add_accessor(model, positions.data(), positions.size() * sizeof(float),
+                   TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, nv,
+                   TINYGLTF_TARGET_ARRAY_BUFFER);
+  model.accessors[position_accessor].minValues = lo;
+  model.accessors[position_accessor].maxValues = hi;
+  primitive.attributes["POSITION"] = position_accessor;
+  if (options.normals.rows() == nv) {
+    std::vector<float> normals(static_cast<std::size_t>(nv) * 3);
+    for (int v = 0; v < nv; ++v) {
+      for (int a = 0; a < 3; ++a) {
+        normals[static_cast<std::size_t>(v) * 3 + a] = static_cast<float>(options.normals(v, a));
+      }
+    }
+    primitive.attributes["NORMAL"] =
+        add_accessor(model, normals.data(), normals.size() * sizeof(float),
+                     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, nv,
+                     TINYGLTF_TARGET_ARRAY_BUFFER);
+  }
+  std::vector<std::uint32_t> indices(static_cast<std::size_t>(mesh.num_faces()) * 3);
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    for (int c = 0; c < 3; ++c) {
+      indices[static_cast<std::size_t>(f) * 3 + c] = static_cast<std::uint32_t>(mesh.F(f, c));
+    }
+  }
+  primitive.indices = add_accessor(model, indices.data(), indices.size() * sizeof(std::uint32_t),
+                                   TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
+                                   indices.size(), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+
+  // Weights, four influences per set.
+  const auto kept = kept_influences(character.weights, options.max_influences, where);
+  std::size_t most = 0;
+  for (const auto& k : kept) most = std::max(most, k.size());
+  const int sets = static_cast<int>((most + 3) / 4);
+  const bool wide = nj > 256;
+  for (int s = 0; s < sets; ++s) {
+    std::vector<std::uint16_t> joints16(static_cast<std::size_t>(nv) * 4, 0);
+    std::vector<std::uint8_t> joints8(static_cast<std::size_t>(nv) * 4, 0);
+    std::vector<float> weights(static_cast<std::size_t>(nv) * 4, 0.0f);
+    for (int v = 0; v < nv; ++v) {
+      const auto& k = kept[static_cast<std::size_t>(v)];
+      for (int i = 0; i < 4; ++i) {
+        const std::size_t at = static_cast<std::size_t>(s) * 4 + i;
+        if (at >= k.size()) break;
+        const std::size_t slot = static_cast<std::size_t>(v) * 4 + i;
+        joints16[slot] = static_cast<std::uint16_t>(k[at].first);
+        joints8[slot] = static_cast<std::uint8_t>(k[at].first);
+        weights[slot] = k[at].second;
+      }
+    }
+    const std::string n = std::to_string(s);
+    primitive.attributes["JOINTS_" + n] =
+        wide ? add_accessor(model, joints16.data(), joints16.size() * 2,
+                            TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC4, nv,
+                            TINYGLTF_TARGET_ARRAY_BUFFER)
+             : add_accessor(model, joints8.data(), joints8.size(),
+                            TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_TYPE_VEC4, nv,
+                            TINYGLTF_TARGET_ARRAY_BUFFER);
+    primitive.attributes["WEIGHTS_" + n] =
+        add_accessor(model, weights.data(), weights.size() * sizeof(float),
+                     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, nv,
+                     TINYGLTF_TARGET_ARRAY_BUFFER);
+  }
+  tinygltf::Mesh gltf_mesh;
+  gltf_mesh.name = character.name;
+  gltf_mesh.primitives.push_back(std::move(primitive));
+  model.meshes.push_back(std::move(gltf_mesh));
+
+  // Skin: inverse bind matrices (column-major) of pure translations.
+  std::vector<float> ibm(static_cast<std::size_t>(nj) * 16, 0.0f);
+  tinygltf::Skin skin;
+  skin.name = character.name + "_skin";
+  skin.skeleton = skeleton.root();
+  for (int j = 0; j < nj; ++j) {
+    float* m = ibm.data() + static_cast<std::size_t>(j) * 16;
+    m[0] = m[5] = m[10] = m[15] = 1.0f;
+    for (int a = 0; a < 3; ++a) m[12 + a] = static_cast<float>(-skeleton.positions(j, a));
+    skin.joints.push_back(j);
+  }
+  skin.inverseBindMatrices =
+      add_accessor(model, ibm.data(), ibm.size() * sizeof(float), TINYGLTF_COMPONENT_TYPE_FLOAT,
+                   TINYGLTF_TYPE_MAT4, nj, /*target: none*/ 0);
+  model.skins.push_back(std::move(skin));
+
+  tinygltf::Node mesh_node;
+  mesh_node.name = character.name;
+  mesh_node.mesh = 0;
+  mesh_node.skin = 0;
+  model.nodes.push_back(std::move(mesh_node));
+
+  tinygltf::Scene scene;
+  scene.name = character.name;
+  scene.nodes = {skeleton.root(), nj};
+  model.scenes.push_back(std::move(scene));
+  model.defaultScene = 0;
+
+  std::ostringstream stream;
+  tinygltf::TinyGLTF writer;
+  const bool binary = ext == ".glb";
+  if (!writer.WriteGltfSceneToStream(&model, stream, /*prettyPrint=*/!binary, binary)) {
+    throw IoError(where + ": TinyGLTF could not serialise the asset");
+  }
+  write_file_atomic(file, stream.str());
+}
+
+}  // namespace skinlab::geometry

@@ -1,0 +1,47 @@
+#pragma once
+/// \file
+/// A skinned character as a glTF 2.0 asset (Khronos glTF 2.0 specification, Sec. 3.7.3
+/// "Skins"), written with TinyGLTF: `.glb` (binary container) or `.gltf` (JSON with the buffer
+/// embedded as a base64 data URI). What `skinlab predict` hands to Blender, game engines and any
+/// other glTF importer.
+///
+/// Layout of the asset:
+///   - one node per joint, in skeleton order (node j is joint j), each with its translation
+///     relative to its parent joint and no rotation or scale, so that joint j's global transform
+///     is the translation to its position: the skeleton is in its bind pose;
+///   - one skin over those nodes, `skeleton` = the root joint, inverse bind matrices
+///     IBM_j = translate(−p_j) (the inverse of the joint's global transform, Sec. 3.7.3.1);
+///   - one mesh node carrying the mesh and the skin (its own transform is the identity, as the
+///     specification asks of skinned mesh nodes); the scene's roots are the root joint and the
+///     mesh node;
+///   - one triangle primitive: POSITION (float32 VEC3 with min/max), unsigned 32-bit indices,
+///     NORMAL when given, and the weights as JOINTS_n (unsigned 8-bit, or 16-bit above 256
+///     joints) and WEIGHTS_n (float32) sets of four influences each.
+///
+/// Weights. Per vertex the non-zero per-joint weights are sorted by decreasing value (ties: lower
+/// joint first) and the largest `max_influences` are kept and renormalised to sum to 1; they are
+/// packed four to a set, so a vertex with at most four influences needs JOINTS_0/WEIGHTS_0 only
+/// and a second set is written only when some vertex keeps more than four (unused slots are
+/// joint 0 with weight 0, as the specification requires).
+
+#include <Eigen/Core>
+#include <filesystem>
+
+#include "framework/geometry/skin_weights.hpp"
+
+namespace skinlab::geometry {
+
+struct GltfExportOptions {
+  /// Influences kept per vertex, 1..8; 4 is what every glTF importer reads (one set).
+  int max_influences = 4;
+  /// #V×3 vertex normals to store, or empty for none.
+  Eigen::MatrixX3d normals;
+};
+
+/// Writes `character` (mesh, skeleton and per-joint weights #V×#J, which must be present) to
+/// `file`, `.glb` or `.gltf` by its extension, atomically. Throws Error for another extension, a
+/// bad option and a character without weights, and IoError when the file cannot be written.
+void write_gltf(const std::filesystem::path& file, const Character& character,
+                const GltfExportOptions& options = {});
+
+}  // namespace skinlab::geometry

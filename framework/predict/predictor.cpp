@@ -1,0 +1,240 @@
+#include "framework/predict/predictor.hpp"
+
+#include <fmt/format.h>
+#include <torch/torch.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "datasets/source.hpp"
+#include "framework/core/atomic_file.hpp"
+#include "framework/core/config.hpp"
+#include "framework/core/error.hpp"
+#include "framework/core/registry.hpp"
+#include "framework/data/h5.hpp"
+#include "framework/data/tensors.hpp"
+#include "framework/eval/evaluate.hpp"
+#include "framework/eval/predictions.hpp"
+#include "framework/eval/weights.hpp"
+#include "framework/models/model.hpp"
+#include "framework/train/checkpoint.hpp"
+#include "framework/train/trainer.hpp"
+
+namespace skinlab::predict {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+}  // namespace
+
+std::string read_preparation(const fs::path& dir, const train::RunOptions& run) {
+  const fs::path own = dir / "preparation.yaml";
+  if (fs::exists(own)) return read_file(own);
+  if (run.data.file.empty()) {
+    throw IoError(dir.string() + ": no preparation.yaml and no data.file in config.yaml");
+  }
+  const fs::path data = run.data.file;
+  if (!fs::exists(data)) {
+    throw IoError(dir.string() + ": no preparation.yaml, and the run's dataset " + data.string() +
+                  " (data.file), whose preprocessing the model needs, does not exist; prepare "
+                  "it again or predict with a bundled model (skinlab bundle)");
+  }
+  const data::H5Reader reader(data);
+  if (!reader.has_attribute("/", "preparation")) {
+    throw IoError(data.string() + ": no 'preparation' attribute (written by skinlab prepare)");
+  }
+  return reader.read_attribute("/", "preparation");
+}
+
+Predictor Predictor::load(const fs::path& dir, const std::string& checkpoint) {
+  const fs::path config_file = dir / "config.yaml";
+  if (!fs::is_directory(dir) || !fs::exists(config_file)) {
+    throw IoError(dir.string() + ": not a model directory (no config.yaml); give a run directory "
+                  "of skinlab train or a bundled model (results/bundled/<name>)");
+  }
+  const config::Config config = config::Config::load(config_file);
+  Predictor p;
+  p.options_ = train::RunOptions::from(config);
+  if (!p.options_.model.exists()) {
+    throw ConfigError(config_file.string() +
+                      ": no model section; skinlab predict needs a trained model");
+  }
+  const fs::path bundled = dir / "model.pt";
+  fs::path weights;
+  if (fs::exists(bundled)) {
+    weights = bundled;
+  } else {
+    if (checkpoint != "best" && checkpoint != "last") {
+      throw Error("unknown checkpoint '" + checkpoint + "'; choose best or last");
+    }
+    weights = dir / (checkpoint + ".pt");
+    if (!fs::exists(weights)) {
+      throw IoError(weights.string() + ": no checkpoint (checkpoints stay out of git; train the "
+                    "run again or use the bundled model)");
+    }
+  }
+
+  const std::string preparation_yaml = read_preparation(dir, p.options_);
+  const config::Config preparation =
+      config::Config::parse(preparation_yaml, (dir / "preparation.yaml").string());
+  p.preprocess_ = data::PreprocessOptions::from(preparation.root()["preprocess"]);
+  const config::Node distances = preparation.root()["distances"];
+  for (std::size_t i = 0; i < distances.size(); ++i) {
+    const config::Node node = distances[i];
+    if (node.required_type("distance") != p.options_.data.distance) continue;
+    p.distances_.push_back({p.options_.data.distance, distance_registry().create(node)});
+  }
+  if (p.distances_.empty()) {
+    throw ConfigError(dir.string() + ": the model reads distance '" + p.options_.data.distance +
+                      "', which its preparation does not list");
+  }
+
+  p.model_ = train::build_model(p.options_);
+  const train::TrainingState state = train::load_checkpoint(weights, *p.model_);
+  p.model_->eval();
+  if (p.options_.metrics.exists() && p.options_.metrics.size() > 0) {
+    p.metrics_ = eval::make_metrics(p.options_.metrics);
+  }
+  p.description_ = fmt::format("{} ({}, epoch {})", dir.string(), weights.filename().string(),
+                               state.epoch);
+  return p;
+}
+
+Prediction Predictor::predict(const geometry::Character& character, const PredictOptions& options,
+                              StageTimes* times) const {
+  if (!(options.prune >= 0 && options.prune <= 1)) {
+    throw Error(fmt::format("prune must be in [0, 1], got {}", options.prune));
+  }
+  datasets::SourceCharacter source;
+  source.character = character;
+  source.path = character.name;
+  source.up = options.up;
+  data::PreprocessMode mode;
+  mode.require_weights = false;
+  mode.laplacian = false;
+  data::PreprocessTimes pre;
+  Prediction out;
+  out.prepared = data::preprocess(source, distances_, preprocess_, mode, &pre);
+  if (times != nullptr) {
+    times->normalise += pre.normalise;
+    times->distance += pre.distance;
+    times->graph += pre.graph;
+  }
+
+  auto start = Clock::now();
+  const data::DistanceData& d = out.prepared.distances.at(distance());
+  for (Eigen::Index v = 0; v < d.topk_distance.rows(); ++v) {
+    for (Eigen::Index k = 0; k < d.topk_distance.cols(); ++k) {
+      if (!std::isfinite(d.topk_distance(v, k))) {
+        throw Error(fmt::format("{}: vertex {} (of the prepared mesh) has no finite {} distance "
+                                "to candidate bone {}; cannot predict its weights",
+                                character.name, v, distance(), d.topk_index(v, k)));
+      }
+    }
+  }
+  const data::CharacterTensors c = data::to_tensors(out.prepared, distance());
+  torch::Tensor candidates;
+  {
+    torch::NoGradGuard no_grad;
+    candidates = model_->forward(c);
+  }
+  train::check_prediction(candidates, c, options_);
+  const torch::Tensor scattered = data::scatter_to_bones(candidates, c.topk_index, c.num_bones());
+  data::RowMatrixXd W = eval::to_eigen(scattered).cast<double>();
+  eval::prune_rows(W, options.prune);
+  for (Eigen::Index v = 0; v < W.rows(); ++v) {
+    if (!(W.row(v).sum() > 0)) {
+      throw Error(fmt::format("{}: the network gave vertex {} (of the prepared mesh) no weight",
+                              character.name, v));
+    }
+  }
+  out.candidates = eval::to_eigen(candidates);
+  out.prepared_weights = W.cast<float>();
+  if (times != nullptr) times->network += seconds_since(start);
+
+  start = Clock::now();
+  out.source_weights = eval::to_source_vertices(out.prepared_weights, out.prepared.vertex_map);
+  out.joint_weights =
+      eval::joint_weights_of(out.source_weights, out.prepared.bones, out.prepared.num_joints());
+  if (times != nullptr) times->map_back += seconds_since(start);
+  return out;
+}
+
+std::map<std::string, double> Predictor::compare(const Prediction& p) const {
+  if (p.prepared.weights.rows() == 0) {
+    throw Error(p.prepared.name + ": the input carries no skin weights to compare with");
+  }
+  const data::CharacterTensors c = data::to_tensors(p.prepared, distance());
+  eval::MetricInputs in;
+  in.pred = torch::from_blob(const_cast<float*>(p.prepared_weights.data()),
+                             {p.prepared_weights.rows(), p.prepared_weights.cols()},
+                             torch::kFloat32)
+                .clone();
+  in.target = c.bone_weights;
+  in.character = &p.prepared;
+  std::map<std::string, double> values;
+  for (const auto& metric : metrics_) {
+    for (const auto& [name, value] : (*metric)(in)) values[name] = value;
+  }
+  return values;
+}
+
+void bundle(const fs::path& run_dir, const fs::path& out, const std::string& checkpoint) {
+  if (fs::exists(out)) throw IoError(out.string() + ": exists; remove it or choose another --out");
+  if (checkpoint != "best" && checkpoint != "last") {
+    throw Error("unknown checkpoint '" + checkpoint + "'; choose best or last");
+  }
+  const fs::path config_file = run_dir / "config.yaml";
+  const fs::path weights = run_dir / (checkpoint + ".pt");
+  for (const fs::path& f : {config_file, weights}) {
+    if (!fs::exists(f)) throw IoError(f.string() + ": missing; bundle needs a trained run");
+  }
+  const train::RunOptions options = train::RunOptions::from(config::Config::load(config_file));
+  if (!options.model.exists()) throw ConfigError(config_file.string() + ": no model section");
+  const std::string preparation = read_preparation(run_dir, options);
+
+  const std::shared_ptr<models::Model> model = train::build_model(options);
+  const train::TrainingState state = train::load_checkpoint(weights, *model);
+
+  fs::path staging = out;
+  staging += ".partial";
+  fs::remove_all(staging);
+  fs::create_directories(staging);
+  try {
+    fs::copy_file(config_file, staging / "config.yaml");
+    write_file_atomic(staging / "preparation.yaml", preparation);
+    train::TrainingState kept;
+    kept.epoch = state.epoch;
+    kept.best_epoch = state.best_epoch;
+    kept.best_loss = state.best_loss;
+    kept.seed = state.seed;
+    kept.threads = state.threads;
+    kept.model_config = state.model_config;
+    train::save_checkpoint(staging / "model.pt", *model, nullptr, kept);
+    for (const auto& entry : fs::directory_iterator(run_dir)) {
+      const std::string name = entry.path().filename().string();
+      const bool provenance = name == "env.json" || name == "metrics.jsonl" ||
+                              (name.rfind("eval_", 0) == 0 &&
+                               (entry.path().extension() == ".json" ||
+                                entry.path().extension() == ".csv"));
+      if (provenance) fs::copy_file(entry.path(), staging / name);
+    }
+    write_file_atomic(staging / "source.txt",
+                      fmt::format("run: {}\ncheckpoint: {}.pt\nepoch: {}\n", run_dir.string(),
+                                  checkpoint, state.epoch));
+    fs::rename(staging, out);
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove_all(staging, ignored);
+    throw;
+  }
+}
+
+}  // namespace skinlab::predict
