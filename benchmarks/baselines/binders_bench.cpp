@@ -36,80 +36,18 @@
 #include "framework/data/preprocess.hpp"
 #include "framework/eval/weights.hpp"
 #include "framework/geometry/closest_point_on_segment.hpp"
+#include "benchmarks/synthetic_body.hpp"
 
 namespace {
 
 using namespace skinlab;
 
-struct Character {
-  geometry::Mesh mesh;
-  geometry::Skeleton skeleton;
-};
+using Character = geometry::Character;
 
-constexpr int kArms = 6;
-struct Size {
-  int sides, rings;
-};
-// 7 tubes of sides·rings + 2 vertices: 1022, 3038, 5054.
-constexpr Size kSizes[] = {{12, 12}, {16, 27}, {20, 36}};
+// 7 tubes of sides·rings + 2 vertices: 1022, 3038, 5054; 33 bones.
+const bench::BodyShape kSizes[] = {{12, 12}, {16, 27}, {20, 36}};
 
-void tube(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double r, int sides, int rings,
-          std::vector<Eigen::Vector3d>& V, std::vector<Eigen::Vector3i>& F) {
-  const Eigen::Vector3d axis = (b - a).normalized();
-  Eigen::Vector3d u = std::abs(axis.x()) > 0.9 ? Eigen::Vector3d(0, 0, 1) : Eigen::Vector3d(1, 0, 0);
-  u = (u - u.dot(axis) * axis).normalized();
-  const Eigen::Vector3d v = axis.cross(u);
-  const int base = static_cast<int>(V.size());
-  for (int i = 0; i < rings; ++i) {
-    for (int j = 0; j < sides; ++j) {
-      const double t = 2 * M_PI * j / sides;
-      V.push_back(a + (b - a) * i / (rings - 1) + r * (std::cos(t) * u + std::sin(t) * v));
-    }
-  }
-  const auto id = [&](int i, int j) { return base + i * sides + j % sides; };
-  for (int i = 0; i + 1 < rings; ++i) {
-    for (int j = 0; j < sides; ++j) {
-      F.emplace_back(id(i, j), id(i, j + 1), id(i + 1, j + 1));
-      F.emplace_back(id(i, j), id(i + 1, j + 1), id(i + 1, j));
-    }
-  }
-  const int ca = static_cast<int>(V.size());
-  V.push_back(a);
-  V.push_back(b);
-  for (int j = 0; j < sides; ++j) {
-    F.emplace_back(ca, id(0, j + 1), id(0, j));
-    F.emplace_back(ca + 1, id(rings - 1, j), id(rings - 1, j + 1));
-  }
-}
-
-Character make_character(const Size& size) {
-  std::vector<Eigen::Vector3d> V;
-  std::vector<Eigen::Vector3i> F;
-  tube({0, 0.05, 0}, {0, 0.95, 0}, 0.08, size.sides, size.rings, V, F);
-  std::vector<std::string> names = {"hips", "chest", "head"};
-  std::vector<std::string> parents = {"", "hips", "chest"};
-  std::vector<Eigen::Vector3d> joints = {{0, 0.1, 0}, {0, 0.5, 0}, {0, 0.9, 0}};
-  for (int k = 0; k < kArms; ++k) {
-    const double phi = 2 * M_PI * (k + 0.25) / kArms;
-    const Eigen::Vector3d dir(std::cos(phi), 0, std::sin(phi)), centre(0, 0.5, 0);
-    tube(centre, centre + 0.45 * dir, 0.04, size.sides, size.rings, V, F);
-    const double at[4] = {0.1, 0.2, 0.3, 0.42};
-    for (int j = 0; j < 4; ++j) {
-      names.push_back("arm" + std::to_string(k) + "_" + std::to_string(j));
-      parents.push_back(j == 0 ? "chest" : names[names.size() - 2]);
-      joints.push_back(centre + at[j] * dir);
-    }
-  }
-  Character c;
-  c.mesh.V.resize(static_cast<Eigen::Index>(V.size()), 3);
-  for (std::size_t i = 0; i < V.size(); ++i) c.mesh.V.row(i) = V[i];
-  c.mesh.F.resize(static_cast<Eigen::Index>(F.size()), 3);
-  for (std::size_t i = 0; i < F.size(); ++i) c.mesh.F.row(i) = F[i];
-  Eigen::MatrixXd J(static_cast<Eigen::Index>(joints.size()), 3);
-  for (std::size_t i = 0; i < joints.size(); ++i) J.row(i) = joints[i];
-  c.skeleton = geometry::Skeleton::from_parent_names(names, J, parents, "bench");
-  return c;
-}
+Character make_character(const bench::BodyShape& size) { return bench::make_body(size, "bench"); }
 
 void BM_Bind(benchmark::State& state, const std::string& yaml) {
   const Character c = make_character(kSizes[state.range(0)]);

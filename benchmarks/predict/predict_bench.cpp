@@ -1,0 +1,145 @@
+// `skinlab predict` stage by stage (framework/predict/predictor.hpp) with the bundled model
+// (results/bundled/heterskinnet, the paper's widths; SKINLAB_PREDICT_MODEL overrides the
+// directory) on synthetic characters of 1K, 3K and 5K vertices with 20 and 50 bones
+// (benchmarks/synthetic_body.hpp), at 1 and 2 threads (libtorch intra-op threads and TBB).
+//
+// BM_Predict/size/bones/threads times one whole prediction from files: load (OBJ + rig text
+// written once beforehand), normalise, distance, graph, network, map back, export (.glb);
+// counters give each stage's mean seconds per prediction, `total_s` their sum, and `peak_rss_mb`
+// the process's peak resident memory so far (getrusage; monotonic over the run, so read the
+// first row of a size for that size alone). Model loading happens once, outside the timing.
+//
+//   build/benchmarks/predict_bench --benchmark_out=predict.json --benchmark_out_format=json
+
+#include <benchmark/benchmark.h>
+#include <sys/resource.h>
+#include <tbb/global_control.h>
+#include <torch/torch.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <memory>
+
+#include "benchmarks/synthetic_body.hpp"
+#include "framework/geometry/gltf_export.hpp"
+#include "framework/geometry/load_character.hpp"
+#include "framework/geometry/obj_io.hpp"
+#include "framework/geometry/rig_io.hpp"
+#include "framework/predict/predictor.hpp"
+
+namespace {
+
+using namespace skinlab;
+namespace fs = std::filesystem;
+
+std::filesystem::path model_dir() {
+  const char* env = std::getenv("SKINLAB_PREDICT_MODEL");
+  return env != nullptr ? fs::path(env) : fs::path(SKINLAB_SOURCE_DIR) / "results" / "bundled" /
+                                              "heterskinnet";
+}
+
+/// Sizes (index 0..2: ~1K, 3K, 5K vertices) for 20 bones (4 spine joints, 4 arms of 3 joints)
+/// and 50 bones (8 spine joints, 6 arms of 6 joints).
+bench::BodyShape shape(int size, int bones) {
+  bench::BodyShape s;
+  if (bones == 20) {
+    const int sides[] = {14, 20, 25}, rings[] = {14, 30, 40};  // 5 tubes: 990, 3010, 5010
+    s.sides = sides[size];
+    s.rings = rings[size];
+    s.arms = 4;
+    s.spine_joints = 4;
+    s.arm_at = {0.1, 0.25, 0.42};
+  } else {
+    const int sides[] = {12, 16, 20}, rings[] = {12, 27, 36};  // 7 tubes: 1022, 3038, 5054
+    s.sides = sides[size];
+    s.rings = rings[size];
+    s.arms = 6;
+    s.spine_joints = 8;
+    s.arm_at = {0.08, 0.15, 0.22, 0.29, 0.36, 0.43};
+  }
+  return s;
+}
+
+const predict::Predictor* predictor() {
+  static std::unique_ptr<predict::Predictor> p;
+  if (!p && fs::exists(model_dir() / "config.yaml")) {
+    p = std::make_unique<predict::Predictor>(predict::Predictor::load(model_dir()));
+  }
+  return p.get();
+}
+
+double peak_rss_mb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;
+}
+
+void BM_Predict(benchmark::State& state) {
+  const int size = static_cast<int>(state.range(0));
+  const int bones = static_cast<int>(state.range(1));
+  const int threads = static_cast<int>(state.range(2));
+  const predict::Predictor* p = predictor();
+  if (p == nullptr) {
+    state.SkipWithError(("no model in " + model_dir().string() +
+                         " (skinlab bundle, or set SKINLAB_PREDICT_MODEL)").c_str());
+    return;
+  }
+  const geometry::Character body = bench::make_body(shape(size, bones));
+  const fs::path dir = fs::temp_directory_path() / "skinlab-predict-bench";
+  fs::create_directories(dir);
+  const fs::path obj = dir / "body.obj", rig = dir / "body_rig.txt", out = dir / "body.glb";
+  geometry::write_obj(obj, body.mesh);
+  geometry::write_rig(rig, body.skeleton, {});
+  torch::set_num_threads(threads);
+  tbb::global_control tbb_threads(tbb::global_control::max_allowed_parallelism, threads);
+
+  predict::StageTimes sum;
+  int prepared_vertices = 0;
+  for (auto _ : state) {
+    predict::StageTimes t;
+    auto start = std::chrono::steady_clock::now();
+    const geometry::Character input = geometry::load_character(obj, rig);
+    t.load = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const predict::Prediction prediction = p->predict(input, {}, &t);
+    start = std::chrono::steady_clock::now();
+    geometry::Character result = input;
+    result.weights = prediction.joint_weights;
+    geometry::write_gltf(out, result);
+    t.export_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    prepared_vertices = prediction.prepared.num_vertices();
+    sum.load += t.load;
+    sum.normalise += t.normalise;
+    sum.distance += t.distance;
+    sum.graph += t.graph;
+    sum.network += t.network;
+    sum.map_back += t.map_back;
+    sum.export_ += t.export_;
+  }
+  const double n = static_cast<double>(state.iterations());
+  state.counters["vertices"] = body.mesh.num_vertices();
+  state.counters["prepared_vertices"] = prepared_vertices;
+  state.counters["bones"] = static_cast<double>(body.skeleton.bones().size());
+  state.counters["threads"] = threads;
+  state.counters["load_s"] = sum.load / n;
+  state.counters["normalise_s"] = sum.normalise / n;
+  state.counters["distance_s"] = sum.distance / n;
+  state.counters["graph_s"] = sum.graph / n;
+  state.counters["network_s"] = sum.network / n;
+  state.counters["map_back_s"] = sum.map_back / n;
+  state.counters["export_s"] = sum.export_ / n;
+  state.counters["total_s"] = sum.total() / n;
+  state.counters["peak_rss_mb"] = peak_rss_mb();
+  fs::remove_all(dir);
+}
+
+BENCHMARK(BM_Predict)
+    ->ArgsProduct({{0, 1, 2}, {20, 50}, {1, 2}})
+    ->ArgNames({"size", "bones", "threads"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+}  // namespace
+
+BENCHMARK_MAIN();
