@@ -34,6 +34,8 @@
 #include "framework/geometry/rig_io.hpp"
 #include "framework/geometry/vertex_normals.hpp"
 #include "framework/predict/predictor.hpp"
+#include "framework/report/plot.hpp"
+#include "framework/report/skin_render.hpp"
 
 namespace skinlab::cli {
 
@@ -48,9 +50,12 @@ struct PredictArgs {
   std::string checkpoint = "best";
   std::vector<std::string> out;
   double prune = 0.25;
+  int max_vertices = 50000;
   std::string up = "y";
   bool compare = false;
   bool timings = false;
+  std::string render;
+  bool error_map = false;
 };
 
 enum class OutputKind { gltf, rig, h5 };
@@ -91,24 +96,40 @@ void write_h5(const fs::path& out, const geometry::Character& input,
 
 int run(const PredictArgs& args) {
   using Clock = std::chrono::steady_clock;
-  if (args.out.empty()) throw Error("predict: give at least one --out file");
+  if (args.out.empty() && args.render.empty()) {
+    throw Error("predict: give at least one --out file or --render");
+  }
   for (const auto& out : args.out) output_kind(out);  // before any work
+  if (!args.render.empty() && fs::path(args.render).extension() != ".png") {
+    throw Error(args.render + ": --render writes a .png file");
+  }
+  if (args.error_map && args.render.empty()) throw Error("--error-map needs --render out.png");
   const Eigen::Vector3d up = up_axis(args.up);
+
+  predict::PredictOptions options;
+  options.prune = args.prune;
+  options.up = up;
+  options.max_vertices = args.max_vertices;
+
+  // The input first: its errors are the cheap ones.
+  predict::StageTimes times;
+  auto start = Clock::now();
+  geometry::Character input = geometry::load_character(args.input, args.rig);
+  try {
+    predict::check_predictable(input, options);
+  } catch (const Error& e) {
+    throw Error((args.rig.empty() ? args.input : args.input + " with " + args.rig) + ": " +
+                e.what());
+  }
+  times.load = std::chrono::duration<double>(Clock::now() - start).count();
+  if ((args.compare || args.error_map) && !input.has_weights()) {
+    throw Error(args.input + ": " + (args.compare ? "--compare-to-input" : "--error-map") +
+                ", but the input carries no skin weights");
+  }
 
   const fs::path model_dir = args.model.empty() ? default_model() : fs::path(args.model);
   const predict::Predictor predictor = predict::Predictor::load(model_dir, args.checkpoint);
   spdlog::info("model: {}", predictor.description());
-
-  predict::StageTimes times;
-  auto start = Clock::now();
-  geometry::Character input = geometry::load_character(args.input, args.rig);
-  times.load = std::chrono::duration<double>(Clock::now() - start).count();
-  if (args.compare && !input.has_weights()) {
-    throw Error(args.input + ": --compare-to-input, but the input carries no skin weights");
-  }
-  predict::PredictOptions options;
-  options.prune = args.prune;
-  options.up = up;
   const predict::Prediction p = predictor.predict(input, options, &times);
 
   if (args.compare) {
@@ -145,6 +166,15 @@ int run(const PredictArgs& args) {
     std::cout << "wrote " << out << "\n";
   }
   times.export_ = std::chrono::duration<double>(Clock::now() - start).count();
+  if (!args.render.empty()) {
+    // In the normalised frame (Y up), at the prepared vertices, where the weights were made.
+    const Eigen::MatrixXd truth =
+        args.error_map ? Eigen::MatrixXd(predictor.ground_truth(p).cast<double>()) : Eigen::MatrixXd();
+    report::write_png(args.render,
+                      report::render_skin(p.prepared.V, p.prepared.F,
+                                          p.prepared_weights.cast<double>(), truth));
+    std::cout << "wrote " << args.render << "\n";
+  }
 
   std::cout << fmt::format("{}: {} vertices ({} prepared), {} joints, {} bones; {:.3f} s\n",
                            input.name, input.mesh.num_vertices(), p.prepared.num_vertices(),
@@ -173,15 +203,20 @@ Command add_predict(CLI::App& app) {
                   "run directory or bundled model (default: results/bundled/heterskinnet)");
   cmd->add_option("--checkpoint", args->checkpoint, "best or last (run directories)")
       ->capture_default_str();
-  cmd->add_option("--out", args->out, "output file: .glb, .gltf, _rig.txt or .h5 (repeatable)")
-      ->required();
+  cmd->add_option("--out", args->out, "output file: .glb, .gltf, _rig.txt or .h5 (repeatable)");
   cmd->add_option("--prune", args->prune,
                   "drop weights below this fraction of the row maximum (HeterSkinNet Sec. 4.5)")
       ->capture_default_str();
   cmd->add_option("--up", args->up, "up axis of the input, y or z")->capture_default_str();
+  cmd->add_option("--max-vertices", args->max_vertices, "refuse inputs with more vertices")
+      ->capture_default_str();
   cmd->add_flag("--compare-to-input", args->compare,
                 "print the metrics against the weights the input carries");
   cmd->add_flag("--timings", args->timings, "print the time of every stage");
+  cmd->add_option("--render", args->render,
+                  "draw the character coloured by its most influential bone (.png)");
+  cmd->add_flag("--error-map", args->error_map,
+                "with --render: add the per-vertex L1 error against the input's weights");
   return {cmd, [args] { return run(*args); }};
 }
 

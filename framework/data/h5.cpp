@@ -108,8 +108,9 @@ template <class T>
 std::vector<T> read_values(H5::H5File& file, const std::filesystem::path& path,
                            const std::string& name, int rank, const H5::PredType& type,
                            std::vector<std::size_t>* dims_out = nullptr) {
-  if (!link_exists(file, name)) throw IoError(path.string() + ": no dataset '" + name + "'");
   try {
+    // Inside the try: on a damaged file the lookup itself fails with an H5::Exception.
+    if (!link_exists(file, name)) throw IoError(path.string() + ": no dataset '" + name + "'");
     std::vector<hsize_t> dims;
     H5::DataSet set = open_dataset(file, path, name, dims);
     if (rank >= 0 && static_cast<int>(dims.size()) != rank) {
@@ -392,9 +393,31 @@ std::string H5Reader::read_attribute(const std::string& object, const std::strin
       throw IoError(path_.string() + ": attribute '" + name + "' of '" + object +
                     "' is not a string");
     }
-    std::string value;
-    attr.read(attr.getStrType(), value);
-    return value;
+    // Read through the C API: for a variable-length string whose stored pointer is null (a
+    // damaged file), HDF5's C++ Attribute::read calls strlen(nullptr) and crashes.
+    const H5::StrType stored = attr.getStrType();
+    if (attr.getSpace().getSimpleExtentNpoints() != 1) {
+      throw IoError(path_.string() + ": attribute '" + name + "' of '" + object +
+                    "' is not a single string");
+    }
+    if (stored.isVariableStr()) {
+      H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);
+      type.setCset(stored.getCset());
+      char* text = nullptr;
+      if (H5Aread(attr.getId(), type.getId(), &text) < 0 || text == nullptr) {
+        throw IoError(path_.string() + ": attribute '" + name + "' of '" + object +
+                      "' cannot be read (damaged string)");
+      }
+      std::string value(text);
+      H5free_memory(text);
+      return value;
+    }
+    std::string buffer(stored.getSize(), '\0');
+    if (!buffer.empty() && H5Aread(attr.getId(), stored.getId(), buffer.data()) < 0) {
+      throw IoError(path_.string() + ": attribute '" + name + "' of '" + object +
+                    "' cannot be read");
+    }
+    return buffer.substr(0, buffer.find('\0'));
   } catch (const H5::Exception& e) {
     rethrow(path_, "cannot read attribute '" + name + "' of '" + object + "'", e);
   }

@@ -21,7 +21,11 @@ Character load_character(const std::filesystem::path& file, const std::filesyste
   if (ext == ".obj") {
     throw GeometryError(file.string() + ": an OBJ mesh has no skeleton; give its RigNet rig file with --rig");
   }
-  return import_character(file);
+  // glTF stores indexed vertices: keep them as they are, so that results map one to one onto
+  // the file's own vertices. Other formats (B3D: one vertex per face corner) are joined.
+  ImportOptions options;
+  options.join_identical_vertices = ext != ".gltf" && ext != ".glb";
+  return import_character(file, options);
 }
 
 }  // namespace skinlab::geometry

@@ -4,6 +4,7 @@
 #include <torch/torch.h>
 
 #include <chrono>
+#include <algorithm>
 #include <cmath>
 
 #include "datasets/source.hpp"
@@ -33,6 +34,45 @@ double seconds_since(Clock::time_point start) {
 }
 
 }  // namespace
+
+void check_predictable(const geometry::Character& c, const PredictOptions& options) {
+  const int nv = c.mesh.num_vertices();
+  if (nv > options.max_vertices) {
+    throw Error(fmt::format("{}: {} vertices, more than the limit of {} (max_vertices; the "
+                            "network's memory grows with #V: decimate the mesh, or raise the "
+                            "limit with --max-vertices)",
+                            c.name, nv, options.max_vertices));
+  }
+  if (nv == 0) throw Error(c.name + ": mesh has no vertices");
+  const Eigen::RowVector3d lo = c.mesh.V.colwise().minCoeff(), hi = c.mesh.V.colwise().maxCoeff();
+  const double diagonal = (hi - lo).norm();
+  const auto& s = c.skeleton;
+  for (int j = 0; j < s.num_joints(); ++j) {
+    const Eigen::RowVector3d p = s.positions.row(j);
+    const Eigen::RowVector3d outside = (lo - p).cwiseMax(p - hi).cwiseMax(0.0);
+    if (outside.norm() > options.max_joint_outside * diagonal) {
+      throw Error(fmt::format(
+          "{}: joint '{}' at ({:.4g}, {:.4g}, {:.4g}) lies {:.4g} outside the mesh's bounding "
+          "box [({:.4g}, {:.4g}, {:.4g}), ({:.4g}, {:.4g}, {:.4g})], more than {} of its "
+          "diagonal: the rig does not fit this mesh (units or frame?)",
+          c.name, s.names[j], p.x(), p.y(), p.z(), outside.norm(), lo.x(), lo.y(), lo.z(),
+          hi.x(), hi.y(), hi.z(), options.max_joint_outside));
+    }
+  }
+  if (s.num_joints() >= 2) {
+    const Eigen::RowVector3d first = s.positions.row(0);
+    double spread = 0;
+    for (int j = 1; j < s.num_joints(); ++j) {
+      spread = std::max(spread, (Eigen::RowVector3d(s.positions.row(j)) - first).norm());
+    }
+    if (!(spread > 1e-9 * std::max(diagonal, 1e-30))) {
+      throw Error(fmt::format("{}: all {} joints sit at one point ({:.4g}, {:.4g}, {:.4g}), so "
+                              "every bone has zero length and none gives a direction to skin "
+                              "along",
+                              c.name, s.num_joints(), first.x(), first.y(), first.z()));
+    }
+  }
+}
 
 std::string read_preparation(const fs::path& dir, const train::RunOptions& run) {
   const fs::path own = dir / "preparation.yaml";
@@ -112,6 +152,7 @@ Prediction Predictor::predict(const geometry::Character& character, const Predic
   if (!(options.prune >= 0 && options.prune <= 1)) {
     throw Error(fmt::format("prune must be in [0, 1], got {}", options.prune));
   }
+  check_predictable(character, options);
   datasets::SourceCharacter source;
   source.character = character;
   source.path = character.name;
@@ -165,6 +206,13 @@ Prediction Predictor::predict(const geometry::Character& character, const Predic
       eval::joint_weights_of(out.source_weights, out.prepared.bones, out.prepared.num_joints());
   if (times != nullptr) times->map_back += seconds_since(start);
   return out;
+}
+
+data::RowMatrixXf Predictor::ground_truth(const Prediction& p) const {
+  if (p.prepared.weights.rows() == 0) {
+    throw Error(p.prepared.name + ": the input carries no skin weights to compare with");
+  }
+  return eval::to_eigen(data::to_tensors(p.prepared, distance()).bone_weights);
 }
 
 std::map<std::string, double> Predictor::compare(const Prediction& p) const {

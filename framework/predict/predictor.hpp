@@ -58,7 +58,20 @@ struct PredictOptions {
   double prune = 0.25;
   /// The input's up direction, rotated to +Y by the normalisation (geometry/normalize.hpp).
   Eigen::Vector3d up = Eigen::Vector3d::UnitY();
+  /// Inputs with more vertices are refused: the network's memory grows linearly with #V (the
+  /// paper's characters have 1K–5K vertices; predict_bench measures the peak at 5K).
+  int max_vertices = 50000;
+  /// A joint farther than this fraction of the mesh's bounding-box diagonal outside that box is
+  /// an error: the rig and the mesh do not belong together (other units or another frame).
+  double max_joint_outside = 0.5;
 };
+
+/// Throws Error naming the character and the element when `character` cannot be predicted
+/// for: more than `options.max_vertices` vertices, a joint outside the mesh (see
+/// PredictOptions::max_joint_outside), or a skeleton of two or more joints that all sit at one
+/// point (every bone has zero length, so no bone has a direction to skin along). Mesh and
+/// skeleton validity (finite, in range, acyclic, one root) are checked when they are loaded.
+void check_predictable(const geometry::Character& character, const PredictOptions& options);
 
 struct Prediction {
   data::PreparedCharacter prepared;      ///< normalised, merged, subdivided; weights if given
@@ -85,6 +98,10 @@ class Predictor {
   /// The metrics of the model's config (`metrics:`) of `p` against the weights the input
   /// carried (HeterSkinNet Sec. 4.3). Throws Error when the input had no weights.
   std::map<std::string, double> compare(const Prediction& p) const;
+  /// #V×#B ground-truth bone weights at the prepared vertices (the bone-level rule of
+  /// data/preprocess.hpp with the model's distance), as `compare` uses them. Throws Error when
+  /// the input had no weights.
+  data::RowMatrixXf ground_truth(const Prediction& p) const;
 
   const train::RunOptions& run_options() const { return options_; }
   const std::string& distance() const { return options_.data.distance; }

@@ -12,32 +12,15 @@
 
 #include "framework/core/atomic_file.hpp"
 #include "framework/data/h5.hpp"
+#include "tests/cli/cli_run.hpp"
 #include "tests/test_util.hpp"
 
 namespace skinlab {
 namespace {
 
+using testing::Result;
+using testing::run;
 using testing::TempDir;
-
-struct Result {
-  int status;
-  std::string out;
-  std::string err;
-};
-
-Result run(const std::string& args) {
-  TempDir dir;
-  const auto err_file = dir / "stderr.txt";
-  const std::string command = std::string("cd '") + SKINLAB_SOURCE_DIR + "' && '" + SKINLAB_CLI +
-                              "' " + args + " 2>'" + err_file.string() + "'";
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (pipe == nullptr) throw std::runtime_error("popen failed");
-  std::string out;
-  std::array<char, 4096> buffer{};
-  while (std::fgets(buffer.data(), buffer.size(), pipe) != nullptr) out += buffer.data();
-  const int status = ::pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out, read_file(err_file)};
-}
 
 TEST(Cli, InfoListsEveryRegistry) {
   const Result r = run("info");

@@ -1,0 +1,37 @@
+#pragma once
+// Runs the `skinlab` binary from the source directory, as a user runs it, and captures its exit
+// status, stdout and stderr (for the CLI tests).
+
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+
+#include "framework/core/atomic_file.hpp"
+#include "tests/test_util.hpp"
+
+namespace skinlab::testing {
+
+struct Result {
+  int status;
+  std::string out;
+  std::string err;
+};
+
+inline Result run(const std::string& args) {
+  TempDir dir;
+  const auto err_file = dir / "stderr.txt";
+  const std::string command = std::string("cd '") + SKINLAB_SOURCE_DIR + "' && '" + SKINLAB_CLI +
+                              "' " + args + " 2>'" + err_file.string() + "'";
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (pipe == nullptr) throw std::runtime_error("popen failed");
+  std::string out;
+  std::array<char, 4096> buffer{};
+  while (std::fgets(buffer.data(), buffer.size(), pipe) != nullptr) out += buffer.data();
+  const int status = ::pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out, read_file(err_file)};
+}
+
+}  // namespace skinlab::testing

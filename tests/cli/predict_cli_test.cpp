@@ -1,0 +1,195 @@
+// `skinlab predict` as a user runs it: the bundled model on a real character and on a plain OBJ
+// with rig text, and the corpus of bad inputs in tests/data/bad/ (each a one-line error naming
+// the file and the element, a non-zero exit, and an existing output file left as it was).
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "framework/core/atomic_file.hpp"
+#include "framework/data/h5.hpp"
+#include "framework/geometry/import_character.hpp"
+#include "framework/geometry/rig_io.hpp"
+#include "tests/cli/cli_run.hpp"
+#include "tests/test_util.hpp"
+
+namespace skinlab {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::Result;
+using testing::run;
+using testing::TempDir;
+
+const std::string kBad = "tests/data/bad/";
+const std::string kPlayer =
+    "/usr/share/games/minetest/games/minetest_game/mods/player_api/models/character.b3d";
+
+/// The lines of `text` that start with "skinlab: error:".
+std::vector<std::string> error_lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::size_t at = 0;
+  while (at < text.size()) {
+    const std::size_t end = text.find('\n', at);
+    const std::string line = text.substr(at, end == std::string::npos ? std::string::npos : end - at);
+    if (line.rfind("skinlab: error:", 0) == 0) lines.push_back(line);
+    if (end == std::string::npos) break;
+    at = end + 1;
+  }
+  return lines;
+}
+
+struct BadCase {
+  std::string args;                   ///< input [--rig ...]
+  std::vector<std::string> expected;  ///< parts of the error line
+};
+
+TEST(PredictCli, EveryBadInputIsAOneLineErrorAndLeavesTheOutputAlone) {
+  TempDir dir;
+  // A 450×450 grid: 202,500 vertices, beyond the default --max-vertices.
+  {
+    std::ofstream big(dir / "big.obj");
+    const int n = 450;
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) big << "v " << i / double(n) << " " << j / double(n) << " 0\n";
+    }
+    for (int j = 0; j + 1 < n; ++j) {
+      for (int i = 0; i + 1 < n; ++i) {
+        const int a = j * n + i + 1;
+        big << "f " << a << " " << a + 1 << " " << a + n + 1 << "\nf " << a << " " << a + n + 1
+            << " " << a + n << "\n";
+      }
+    }
+  }
+  const std::string big = (dir / "big.obj").string();
+  const std::vector<BadCase> cases = {
+      {kBad + "empty.obj --rig " + kBad + "box_rig.txt", {"empty.obj", "no vertices"}},
+      {kBad + "nan_vertex.obj --rig " + kBad + "box_rig.txt",
+       {"nan_vertex.obj", "vertex 6", "non-finite"}},
+      {kBad + "face_out_of_range.obj --rig " + kBad + "box_rig.txt",
+       {"face_out_of_range.obj:19", "vertex 9", "out of range"}},
+      {kBad + "garbage.fbx", {"garbage.fbx", "assimp cannot read it"}},
+      {kBad + "box.obj --rig " + kBad + "unknown_joint_rig.txt",
+       {"unknown_joint_rig.txt:5", "unknown joint 'head'"}},
+      {kBad + "box.obj --rig " + kBad + "cycle_rig.txt", {"cycle_rig.txt", "cycle", "'a'"}},
+      {kBad + "box.obj --rig " + kBad + "two_roots_rig.txt",
+       {"two_roots_rig.txt", "joint 'other'", "not the root"}},
+      {kBad + "box.obj --rig " + kBad + "bone_outside_rig.txt",
+       {"bone_outside_rig.txt", "joint 'far'", "outside the mesh's bounding box"}},
+      {kBad + "box.obj --rig " + kBad + "zero_length_rig.txt",
+       {"zero_length_rig.txt", "all 3 joints sit at one point", "zero length"}},
+      {kBad + "one_vertex.obj --rig " + kBad + "one_vertex_rig.txt",
+       {"one_vertex.obj", "no faces"}},
+      {big + " --rig " + kBad + "box_rig.txt", {"big.obj", "202500 vertices", "--max-vertices"}},
+      {kBad + "missing.obj --rig " + kBad + "box_rig.txt", {"missing.obj"}},
+  };
+  const fs::path out = dir / "out.glb";
+  for (const BadCase& c : cases) {
+    write_file_atomic(out, "a good file from an earlier run");
+    const Result r = run("predict " + c.args + " --out " + out.string());
+    EXPECT_EQ(r.status, 1) << c.args << "\n" << r.err;
+    const auto lines = error_lines(r.err);
+    ASSERT_EQ(lines.size(), 1u) << c.args << "\n" << r.err;
+    for (const auto& part : c.expected) {
+      EXPECT_NE(lines[0].find(part), std::string::npos) << c.args << ": '" << part << "' not in\n"
+                                                        << lines[0];
+    }
+    EXPECT_EQ(read_file(out), "a good file from an earlier run") << c.args;
+    EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator()), 2)
+        << c.args << ": a stray file was left";
+  }
+}
+
+TEST(PredictCli, UsageErrorsComeBeforeAnyWork) {
+  TempDir dir;
+  const Result ext = run("predict " + kBad + "box.obj --rig " + kBad + "box_rig.txt --out " +
+                         (dir / "w.fbx").string());
+  EXPECT_EQ(ext.status, 1);
+  EXPECT_NE(ext.err.find("unknown output type '.fbx'"), std::string::npos) << ext.err;
+  const Result model = run("predict " + kBad + "box.obj --rig " + kBad + "box_rig.txt --model " +
+                           (dir / "nomodel").string() + " --out " + (dir / "w.glb").string());
+  EXPECT_EQ(model.status, 1);
+  EXPECT_NE(model.err.find("not a model directory"), std::string::npos) << model.err;
+  const Result compare = run("predict " + kBad + "box.obj --rig " + kBad +
+                             "box_rig.txt --compare-to-input --out " + (dir / "w.glb").string());
+  EXPECT_EQ(compare.status, 1);
+  EXPECT_NE(compare.err.find("carries no skin weights"), std::string::npos) << compare.err;
+  EXPECT_TRUE(fs::is_empty(dir.path()));
+}
+
+TEST(PredictCli, BundledModelSkinsARealCharacterAndAPlainObj) {
+  TempDir dir;
+  const fs::path glb = dir / "player.glb", rig = dir / "player_rig.txt", h5 = dir / "player.h5";
+  const Result r = run("predict " + kPlayer + " --compare-to-input --timings --out " +
+                       glb.string() + " --out " + rig.string() + " --out " + h5.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("against the input's weights: avg_l1"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("stages (s): load"), std::string::npos) << r.out;
+
+  const geometry::Character input = geometry::import_character(kPlayer);
+  geometry::ImportOptions o;
+  o.join_identical_vertices = false;
+  const geometry::Character back = geometry::import_character(glb, o);
+  EXPECT_EQ(back.skeleton.names, input.skeleton.names);
+  EXPECT_EQ(back.skeleton.parents, input.skeleton.parents);
+  EXPECT_EQ(back.mesh.num_vertices(), input.mesh.num_vertices());
+  // The rig text and the HDF5 file carry the same per-joint weights; the glTF their top 4.
+  const geometry::Rig text = geometry::read_rig(rig, input.mesh.num_vertices());
+  const data::H5Reader file(h5);
+  const data::RowMatrixXd joint = file.read_double("joint_weights");
+  ASSERT_EQ(joint.rows(), input.mesh.num_vertices());
+  EXPECT_LT((Eigen::MatrixXd(text.weights) - Eigen::MatrixXd(joint)).cwiseAbs().maxCoeff(), 1e-6);
+  EXPECT_LT((Eigen::MatrixXd(back.weights) - Eigen::MatrixXd(joint)).cwiseAbs().maxCoeff(), 1e-6)
+      << "the player's vertices have at most 4 influences after pruning";
+  EXPECT_EQ(file.read_strings("joint_names"), input.skeleton.names);
+
+  const Result obj = run("predict " + kBad + "box.obj --rig " + kBad + "box_rig.txt --out " +
+                         (dir / "box.gltf").string());
+  ASSERT_EQ(obj.status, 0) << obj.err;
+  const geometry::Character box = geometry::import_character(dir / "box.gltf", o);
+  EXPECT_EQ(box.skeleton.names, (std::vector<std::string>{"root", "mid", "top"}));
+  EXPECT_EQ(box.mesh.num_vertices(), 8);
+}
+
+TEST(PredictCli, GameCharacterExportedFromItsSourceIsSkinnedAndRendered) {
+  // A real 0 A.D. character of the bundled subset, exported from its PMD with the artist's
+  // weights, then skinned by the bundled model and compared with those weights.
+  TempDir dir;
+  const fs::path horse = dir / "horse.glb";
+  const Result e = run("export configs/datasets/zeroad_bundled.yaml horse --out " + horse.string());
+  ASSERT_EQ(e.status, 0) << e.err;
+  EXPECT_NE(e.out.find("horse (zeroad: art/meshes/skeletal/horse.dae.cached.pmd)"),
+            std::string::npos)
+      << e.out;
+  geometry::ImportOptions o;
+  o.join_identical_vertices = false;
+  const geometry::Character artist = geometry::import_character(horse, o);
+
+  const fs::path out = dir / "horse_skinned.glb", png = dir / "horse.png";
+  const Result r = run("predict " + horse.string() + " --compare-to-input --out " + out.string() +
+                       " --render " + png.string() + " --error-map");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto at = r.out.find("precision ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  const double precision = std::stod(r.out.substr(at + 10));
+  EXPECT_GT(precision, 0.3) << r.out;  // a trained model, not a random one
+  const geometry::Character skinned = geometry::import_character(out, o);
+  EXPECT_EQ(skinned.skeleton.names, artist.skeleton.names);
+  EXPECT_EQ(skinned.mesh.num_vertices(), artist.mesh.num_vertices());
+  EXPECT_LT((skinned.skeleton.positions - artist.skeleton.positions).cwiseAbs().maxCoeff(), 1e-5);
+  const std::string image = read_file(png);
+  ASSERT_GT(image.size(), 8u);
+  EXPECT_EQ(image.substr(1, 3), "PNG");
+
+  const Result missing = run("export configs/datasets/zeroad_bundled.yaml unicorn --out " +
+                             (dir / "u.glb").string());
+  EXPECT_EQ(missing.status, 1);
+  EXPECT_NE(missing.err.find("no character 'unicorn'"), std::string::npos) << missing.err;
+  EXPECT_FALSE(fs::exists(dir / "u.glb"));
+}
+
+}  // namespace
+}  // namespace skinlab
