@@ -220,6 +220,77 @@ Command add_predict(CLI::App& app) {
   return {cmd, [args] { return run(*args); }};
 }
 
+/// `skinlab score <character> [--rig] --weights <other>`: the model's metrics of another
+/// method's weights (RigNet rig text, or a glTF/any assimp file of the same mesh) against the
+/// character's own (artist) weights, joints matched by name.
+int run_score(const std::string& input, const std::string& rig, const std::string& weights,
+              const std::string& model) {
+  const geometry::Character truth = geometry::load_character(input, rig);
+  if (!truth.has_weights()) throw Error(input + ": carries no skin weights to score against");
+  const fs::path file = weights;
+  geometry::Skeleton other_skeleton;
+  geometry::SparseWeights other;
+  if (file.extension() == ".txt") {
+    geometry::Rig r = geometry::read_rig(file, truth.mesh.num_vertices());
+    other_skeleton = r.skeleton;
+    other = r.weights;
+  } else {
+    geometry::Character c = geometry::load_character(file);
+    if (c.mesh.num_vertices() != truth.mesh.num_vertices()) {
+      throw Error(fmt::format("{}: {} vertices, but {} has {}", weights, c.mesh.num_vertices(),
+                              input, truth.mesh.num_vertices()));
+    }
+    other_skeleton = c.skeleton;
+    other = c.weights;
+  }
+  if (other.rows() != truth.mesh.num_vertices()) {
+    throw Error(weights + ": no weights for the " + std::to_string(truth.mesh.num_vertices()) +
+                " vertices of " + input);
+  }
+  // Columns by joint name onto the truth's skeleton.
+  std::vector<Eigen::Triplet<double>> entries;
+  for (Eigen::Index v = 0; v < other.outerSize(); ++v) {
+    for (geometry::SparseWeights::InnerIterator it(other, v); it; ++it) {
+      const std::string& name = other_skeleton.names[static_cast<std::size_t>(it.col())];
+      const int j = truth.skeleton.find(name);
+      if (j < 0) throw Error(weights + ": joint '" + name + "' is not a joint of " + input);
+      entries.emplace_back(static_cast<int>(v), j, it.value());
+    }
+  }
+  geometry::SparseWeights mapped(truth.mesh.num_vertices(), truth.skeleton.num_joints());
+  mapped.setFromTriplets(entries.begin(), entries.end());
+  for (Eigen::Index v = 0; v < mapped.rows(); ++v) {
+    if (!(mapped.row(v).sum() > 0)) {
+      throw Error(fmt::format("{}: vertex {} has no weight", weights, v));
+    }
+    mapped.row(v) /= mapped.row(v).sum();
+  }
+  const fs::path model_dir = model.empty() ? default_model() : fs::path(model);
+  const predict::Predictor predictor = predict::Predictor::load(model_dir);
+  const auto values = predictor.score(truth, mapped);
+  std::cout << fmt::format("{} against the weights of {}:", weights, input);
+  for (const auto& [name, value] : values) std::cout << fmt::format(" {} {:.4f}", name, value);
+  std::cout << "\n";
+  return 0;
+}
+
+Command add_score(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "score", "the paper's metrics of another method's weights against a character's own");
+  auto input = std::make_shared<std::string>();
+  auto rig = std::make_shared<std::string>();
+  auto weights = std::make_shared<std::string>();
+  auto model = std::make_shared<std::string>();
+  cmd->add_option("input", *input, "character with its artist weights (assimp file or OBJ)")
+      ->required();
+  cmd->add_option("--rig", *rig, "RigNet rig text of an OBJ input");
+  cmd->add_option("--weights", *weights, "weights to score: _rig.txt or a file of the same mesh")
+      ->required();
+  cmd->add_option("--model", *model,
+                  "model whose preparation and metrics are used (default: the bundled one)");
+  return {cmd, [=] { return run_score(*input, *rig, *weights, *model); }};
+}
+
 Command add_bundle(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "bundle", "a self-contained model directory for skinlab predict from a trained run");

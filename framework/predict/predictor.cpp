@@ -234,6 +234,39 @@ std::map<std::string, double> Predictor::compare(const Prediction& p) const {
   return values;
 }
 
+std::map<std::string, double> Predictor::score(const geometry::Character& truth,
+                                               const geometry::SparseWeights& other,
+                                               const PredictOptions& options) const {
+  if (!truth.has_weights()) throw Error(truth.name + ": no weights to score against");
+  if (other.rows() != truth.mesh.num_vertices() || other.cols() != truth.skeleton.num_joints()) {
+    throw Error(fmt::format("{}: the weights to score are {}×{}, expected #V×#J = {}×{}",
+                            truth.name, other.rows(), other.cols(), truth.mesh.num_vertices(),
+                            truth.skeleton.num_joints()));
+  }
+  check_predictable(truth, options);
+  data::PreprocessMode mode;
+  mode.laplacian = false;
+  auto prepare = [&](const geometry::SparseWeights& W) {
+    datasets::SourceCharacter source;
+    source.character = truth;
+    source.character.weights = W;
+    source.path = truth.name;
+    source.up = options.up;
+    return data::preprocess(source, distances_, preprocess_, mode);
+  };
+  const data::PreparedCharacter t = prepare(truth.weights);
+  const data::PreparedCharacter o = prepare(other);
+  eval::MetricInputs in;
+  in.pred = data::to_tensors(o, distance()).bone_weights;
+  in.target = data::to_tensors(t, distance()).bone_weights;
+  in.character = &t;
+  std::map<std::string, double> values;
+  for (const auto& metric : metrics_) {
+    for (const auto& [name, value] : (*metric)(in)) values[name] = value;
+  }
+  return values;
+}
+
 void bundle(const fs::path& run_dir, const fs::path& out, const std::string& checkpoint) {
   if (fs::exists(out)) throw IoError(out.string() + ": exists; remove it or choose another --out");
   if (checkpoint != "best" && checkpoint != "last") {

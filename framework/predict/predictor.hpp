@@ -103,6 +103,15 @@ class Predictor {
   /// the input had no weights.
   data::RowMatrixXf ground_truth(const Prediction& p) const;
 
+  /// The metrics of the model's config of another method's per-joint weights `other` (#V×#J of
+  /// `truth`'s mesh and skeleton, e.g. Blender's automatic weights) against `truth`'s own
+  /// weights, both prepared exactly as a prediction's (merged, subdivided, bone-level rule with
+  /// the model's distance). Throws Error naming the character when `truth` has no weights or
+  /// `other` has another shape.
+  std::map<std::string, double> score(const geometry::Character& truth,
+                                      const geometry::SparseWeights& other,
+                                      const PredictOptions& options = {}) const;
+
   const train::RunOptions& run_options() const { return options_; }
   const std::string& distance() const { return options_.data.distance; }
   /// "results/heterskinnet/full-20261201 (best, epoch 35)" and the like, for logs.

@@ -184,6 +184,15 @@ TEST(PredictCli, GameCharacterExportedFromItsSourceIsSkinnedAndRendered) {
   ASSERT_GT(image.size(), 8u);
   EXPECT_EQ(image.substr(1, 3), "PNG");
 
+  // skinlab score: the artist's weights scored against themselves lose only what the 0.25
+  // pruning of every scored method removes (precision 1); a file of another mesh is refused.
+  const Result self = run("score " + horse.string() + " --weights " + horse.string());
+  ASSERT_EQ(self.status, 0) << self.err;
+  EXPECT_NE(self.out.find("precision 1.0000"), std::string::npos) << self.out;
+  const Result other = run("score " + horse.string() + " --weights " + kPlayer);
+  EXPECT_EQ(other.status, 1);
+  EXPECT_NE(other.err.find("vertices, but"), std::string::npos) << other.err;
+
   const Result missing = run("export configs/datasets/zeroad_bundled.yaml unicorn --out " +
                              (dir / "u.glb").string());
   EXPECT_EQ(missing.status, 1);
