@@ -169,7 +169,7 @@ int run(const PredictArgs& args) {
   if (!args.render.empty()) {
     // In the normalised frame (Y up), at the prepared vertices, where the weights were made.
     const Eigen::MatrixXd truth =
-        args.error_map ? Eigen::MatrixXd(predictor.ground_truth(p).cast<double>()) : Eigen::MatrixXd();
+        args.error_map ? Eigen::MatrixXd(p.prepared_truth.cast<double>()) : Eigen::MatrixXd();
     report::write_png(args.render,
                       report::render_skin(p.prepared.V, p.prepared.F,
                                           p.prepared_weights.cast<double>(), truth));
@@ -219,6 +219,8 @@ Command add_predict(CLI::App& app) {
                 "with --render: add the per-vertex L1 error against the input's weights");
   return {cmd, [args] { return run(*args); }};
 }
+
+namespace {
 
 /// `skinlab score <character> [--rig] --weights <other>`: the model's metrics of another
 /// method's weights (RigNet rig text, or a glTF/any assimp file of the same mesh) against the
@@ -273,6 +275,8 @@ int run_score(const std::string& input, const std::string& rig, const std::strin
   std::cout << "\n";
   return 0;
 }
+
+}  // namespace
 
 Command add_score(CLI::App& app) {
   auto* cmd = app.add_subcommand(

@@ -3,8 +3,8 @@
 #include <fmt/format.h>
 #include <torch/torch.h>
 
-#include <chrono>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "datasets/source.hpp"
@@ -198,6 +198,7 @@ Prediction Predictor::predict(const geometry::Character& character, const Predic
   }
   out.candidates = eval::to_eigen(candidates);
   out.prepared_weights = W.cast<float>();
+  if (c.bone_weights.defined()) out.prepared_truth = eval::to_eigen(c.bone_weights);
   if (times != nullptr) times->network += seconds_since(start);
 
   start = Clock::now();
@@ -208,30 +209,28 @@ Prediction Predictor::predict(const geometry::Character& character, const Predic
   return out;
 }
 
-data::RowMatrixXf Predictor::ground_truth(const Prediction& p) const {
-  if (p.prepared.weights.rows() == 0) {
-    throw Error(p.prepared.name + ": the input carries no skin weights to compare with");
-  }
-  return eval::to_eigen(data::to_tensors(p.prepared, distance()).bone_weights);
-}
-
-std::map<std::string, double> Predictor::compare(const Prediction& p) const {
-  if (p.prepared.weights.rows() == 0) {
-    throw Error(p.prepared.name + ": the input carries no skin weights to compare with");
-  }
-  const data::CharacterTensors c = data::to_tensors(p.prepared, distance());
+std::map<std::string, double> Predictor::metrics_of(const torch::Tensor& pred,
+                                                    const torch::Tensor& target,
+                                                    const data::PreparedCharacter& character) const {
   eval::MetricInputs in;
-  in.pred = torch::from_blob(const_cast<float*>(p.prepared_weights.data()),
-                             {p.prepared_weights.rows(), p.prepared_weights.cols()},
-                             torch::kFloat32)
-                .clone();
-  in.target = c.bone_weights;
-  in.character = &p.prepared;
+  in.pred = pred;
+  in.target = target;
+  in.character = &character;
   std::map<std::string, double> values;
   for (const auto& metric : metrics_) {
     for (const auto& [name, value] : (*metric)(in)) values[name] = value;
   }
   return values;
+}
+
+std::map<std::string, double> Predictor::compare(const Prediction& p) const {
+  if (p.prepared_truth.rows() == 0) {
+    throw Error(p.prepared.name + ": the input carries no skin weights to compare with");
+  }
+  auto tensor = [](const data::RowMatrixXf& m) {
+    return torch::from_blob(const_cast<float*>(m.data()), {m.rows(), m.cols()}, torch::kFloat32);
+  };
+  return metrics_of(tensor(p.prepared_weights), tensor(p.prepared_truth), p.prepared);
 }
 
 std::map<std::string, double> Predictor::score(const geometry::Character& truth,
@@ -256,15 +255,8 @@ std::map<std::string, double> Predictor::score(const geometry::Character& truth,
   };
   const data::PreparedCharacter t = prepare(truth.weights);
   const data::PreparedCharacter o = prepare(other);
-  eval::MetricInputs in;
-  in.pred = data::to_tensors(o, distance()).bone_weights;
-  in.target = data::to_tensors(t, distance()).bone_weights;
-  in.character = &t;
-  std::map<std::string, double> values;
-  for (const auto& metric : metrics_) {
-    for (const auto& [name, value] : (*metric)(in)) values[name] = value;
-  }
-  return values;
+  return metrics_of(data::to_tensors(o, distance()).bone_weights,
+                    data::to_tensors(t, distance()).bone_weights, t);
 }
 
 void bundle(const fs::path& run_dir, const fs::path& out, const std::string& checkpoint) {
@@ -291,13 +283,9 @@ void bundle(const fs::path& run_dir, const fs::path& out, const std::string& che
   try {
     fs::copy_file(config_file, staging / "config.yaml");
     write_file_atomic(staging / "preparation.yaml", preparation);
-    train::TrainingState kept;
-    kept.epoch = state.epoch;
-    kept.best_epoch = state.best_epoch;
-    kept.best_loss = state.best_loss;
-    kept.seed = state.seed;
-    kept.threads = state.threads;
-    kept.model_config = state.model_config;
+    train::TrainingState kept = state;  // without the RNG states: nothing resumes a bundle
+    kept.torch_rng = torch::Tensor();
+    kept.order_rng = torch::Tensor();
     train::save_checkpoint(staging / "model.pt", *model, nullptr, kept);
     for (const auto& entry : fs::directory_iterator(run_dir)) {
       const std::string name = entry.path().filename().string();

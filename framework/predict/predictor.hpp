@@ -18,6 +18,8 @@
 /// vertex whose candidate distances are not finite is an error naming the vertex, never a
 /// silent zero row.
 
+#include <torch/torch.h>
+
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -79,6 +81,9 @@ struct Prediction {
   data::RowMatrixXf prepared_weights;    ///< #V×#B at the prepared vertices, pruned
   data::RowMatrixXf source_weights;      ///< #V_in×#B at the input's vertices, pruned
   geometry::SparseWeights joint_weights; ///< #V_in×#J per-joint weights at the input's vertices
+  /// #V×#B ground-truth bone weights at the prepared vertices when the input carried weights
+  /// (the bone-level rule of data/preprocess.hpp with the model's distance); 0×0 otherwise
+  data::RowMatrixXf prepared_truth;
 };
 
 class Predictor {
@@ -98,10 +103,6 @@ class Predictor {
   /// The metrics of the model's config (`metrics:`) of `p` against the weights the input
   /// carried (HeterSkinNet Sec. 4.3). Throws Error when the input had no weights.
   std::map<std::string, double> compare(const Prediction& p) const;
-  /// #V×#B ground-truth bone weights at the prepared vertices (the bone-level rule of
-  /// data/preprocess.hpp with the model's distance), as `compare` uses them. Throws Error when
-  /// the input had no weights.
-  data::RowMatrixXf ground_truth(const Prediction& p) const;
 
   /// The metrics of the model's config of another method's per-joint weights `other` (#V×#J of
   /// `truth`'s mesh and skeleton, e.g. Blender's automatic weights) against `truth`'s own
@@ -119,6 +120,9 @@ class Predictor {
 
  private:
   Predictor() = default;
+  /// The config's metrics of `pred` against `target` (#V×#B each) on `character`.
+  std::map<std::string, double> metrics_of(const torch::Tensor& pred, const torch::Tensor& target,
+                                           const data::PreparedCharacter& character) const;
   train::RunOptions options_;
   std::shared_ptr<models::Model> model_;
   std::vector<data::NamedDistance> distances_;  ///< the one the model reads
