@@ -9,20 +9,37 @@
 // the process's peak resident memory so far (getrusage; monotonic over the run, so read the
 // first row of a size for that size alone). Model loading happens once, outside the timing.
 //
+// BM_PredictCli/size/bones/threads runs the `skinlab predict` program on the same files, one
+// process per iteration: what a user waits for, with libtorch's start-up and the model's
+// loading included; `peak_rss_mb` is the largest the program reported (`--timings` prints its
+// VmHWM: getrusage's figure for children would count this process's pages the forked child
+// held before exec). BM_CliStartup is `skinlab --help`
+// (loading the shared libraries and their static initialisers, nothing of ours), and
+// BM_LoadModel the bundled model's loading in process.
+//
+// Like `skinlab` (framework/cli/main.cpp) the program keeps freed memory in the heap
+// (keep_freed_memory), so the in-process figures are those of the program.
+//
 //   build/benchmarks/predict_bench --benchmark_out=predict.json --benchmark_out_format=json
 
 #include <benchmark/benchmark.h>
+#include <fmt/core.h>
 #include <sys/resource.h>
 #include <tbb/global_control.h>
 #include <torch/torch.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <memory>
 
 #include "benchmarks/synthetic_body.hpp"
+#include "framework/core/environment.hpp"
 #include "framework/geometry/gltf_export.hpp"
 #include "framework/geometry/load_character.hpp"
 #include "framework/geometry/obj_io.hpp"
@@ -76,6 +93,40 @@ double peak_rss_mb() {
   return static_cast<double>(usage.ru_maxrss) / 1024.0;
 }
 
+/// The synthetic character of `size` and `bones` as OBJ + rig text in a scratch directory.
+struct BodyFiles {
+  fs::path dir, obj, rig, out;
+  int vertices = 0, bones = 0;
+  BodyFiles(int size, int bone_count) {
+    const geometry::Character body = bench::make_body(shape(size, bone_count));
+    dir = fs::temp_directory_path() / "skinlab-predict-bench";
+    fs::create_directories(dir);
+    obj = dir / "body.obj";
+    rig = dir / "body_rig.txt";
+    out = dir / "body.glb";
+    geometry::write_obj(obj, body.mesh);
+    geometry::write_rig(rig, body.skeleton, {});
+    vertices = body.mesh.num_vertices();
+    bones = static_cast<int>(body.skeleton.bones().size());
+  }
+  ~BodyFiles() { fs::remove_all(dir); }
+  BodyFiles(const BodyFiles&) = delete;
+  BodyFiles& operator=(const BodyFiles&) = delete;
+};
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+/// Runs a shell command, failing the benchmark if it does not exit with 0.
+bool run(benchmark::State& state, const std::string& command) {
+  if (std::system(command.c_str()) != 0) {
+    state.SkipWithError(("command failed: " + command).c_str());
+    return false;
+  }
+  return true;
+}
+
 void BM_Predict(benchmark::State& state) {
   const int size = static_cast<int>(state.range(0));
   const int bones = static_cast<int>(state.range(1));
@@ -86,12 +137,8 @@ void BM_Predict(benchmark::State& state) {
                          " (skinlab bundle, or set SKINLAB_PREDICT_MODEL)").c_str());
     return;
   }
-  const geometry::Character body = bench::make_body(shape(size, bones));
-  const fs::path dir = fs::temp_directory_path() / "skinlab-predict-bench";
-  fs::create_directories(dir);
-  const fs::path obj = dir / "body.obj", rig = dir / "body_rig.txt", out = dir / "body.glb";
-  geometry::write_obj(obj, body.mesh);
-  geometry::write_rig(rig, body.skeleton, {});
+  const BodyFiles files(size, bones);
+  const fs::path &obj = files.obj, &rig = files.rig, &out = files.out;
   torch::set_num_threads(threads);
   tbb::global_control tbb_threads(tbb::global_control::max_allowed_parallelism, threads);
 
@@ -101,13 +148,13 @@ void BM_Predict(benchmark::State& state) {
     predict::StageTimes t;
     auto start = std::chrono::steady_clock::now();
     const geometry::Character input = geometry::load_character(obj, rig);
-    t.load = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    t.load = seconds_since(start);
     const predict::Prediction prediction = p->predict(input, {}, &t);
     start = std::chrono::steady_clock::now();
     geometry::Character result = input;
     result.weights = prediction.joint_weights;
     geometry::write_gltf(out, result);
-    t.export_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    t.export_ = seconds_since(start);
     prepared_vertices = prediction.prepared.num_vertices();
     sum.load += t.load;
     sum.normalise += t.normalise;
@@ -118,9 +165,9 @@ void BM_Predict(benchmark::State& state) {
     sum.export_ += t.export_;
   }
   const double n = static_cast<double>(state.iterations());
-  state.counters["vertices"] = body.mesh.num_vertices();
+  state.counters["vertices"] = files.vertices;
   state.counters["prepared_vertices"] = prepared_vertices;
-  state.counters["bones"] = static_cast<double>(body.skeleton.bones().size());
+  state.counters["bones"] = files.bones;
   state.counters["threads"] = threads;
   state.counters["load_s"] = sum.load / n;
   state.counters["normalise_s"] = sum.normalise / n;
@@ -131,7 +178,50 @@ void BM_Predict(benchmark::State& state) {
   state.counters["export_s"] = sum.export_ / n;
   state.counters["total_s"] = sum.total() / n;
   state.counters["peak_rss_mb"] = peak_rss_mb();
-  fs::remove_all(dir);
+}
+
+/// The "peak memory N MiB" that `skinlab predict --timings` printed into `log`, or -1.
+double reported_peak_mib(const fs::path& log) {
+  std::ifstream in(log);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string key = "peak memory ";
+  const std::size_t at = text.rfind(key);
+  return at == std::string::npos ? -1.0 : std::stod(text.substr(at + key.size()));
+}
+
+void BM_PredictCli(benchmark::State& state) {
+  const int size = static_cast<int>(state.range(0));
+  const int bones = static_cast<int>(state.range(1));
+  const int threads = static_cast<int>(state.range(2));
+  const BodyFiles files(size, bones);
+  const fs::path log = files.dir / "predict.log";
+  const std::string command =
+      fmt::format("'{}' --threads {} --log-level warn predict '{}' --rig '{}' --model '{}' "
+                  "--out '{}' --timings > '{}'",
+                  SKINLAB_BINARY, threads, files.obj.string(), files.rig.string(),
+                  model_dir().string(), files.out.string(), log.string());
+  double peak = 0;
+  for (auto _ : state) {
+    if (!run(state, command)) return;
+    peak = std::max(peak, reported_peak_mib(log));
+  }
+  state.counters["vertices"] = files.vertices;
+  state.counters["bones"] = files.bones;
+  state.counters["threads"] = threads;
+  state.counters["peak_rss_mb"] = peak;
+}
+
+void BM_CliStartup(benchmark::State& state) {
+  const std::string command = fmt::format("'{}' --help > /dev/null", SKINLAB_BINARY);
+  for (auto _ : state) {
+    if (!run(state, command)) return;
+  }
+}
+
+void BM_LoadModel(benchmark::State& state) {
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(predict::Predictor::load(model_dir()));
+  }
 }
 
 BENCHMARK(BM_Predict)
@@ -139,7 +229,21 @@ BENCHMARK(BM_Predict)
     ->ArgNames({"size", "bones", "threads"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+BENCHMARK(BM_PredictCli)
+    ->ArgsProduct({{0, 1, 2}, {20, 50}, {1, 2}})
+    ->ArgNames({"size", "bones", "threads"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_CliStartup)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_LoadModel)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  keep_freed_memory();
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

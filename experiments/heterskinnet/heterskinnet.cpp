@@ -76,10 +76,17 @@ torch::Tensor HeterSkinNet::forward(const data::CharacterTensors& c) {
   const graph::Features x = stem_->forward(in, g);
   const graph::Features glob = global_->forward(x, g);
   const graph::Features loc = local_->forward(x, g);
+  // The head's input is [local vertex ‖ its K candidates' local bone features ‖ global]; the
+  // global part is one row broadcast to all vertices when global_pool does not keep its input.
+  const bool broadcast = glob.vertex.size(0) == nv && glob.vertex.stride(0) == 0;
+  if (broadcast) {
+    return torch::softmax(
+        head_->forward_gathered(loc.vertex, loc.bone, c.topk_index, glob.vertex.narrow(0, 0, 1)),
+        1);
+  }
   const torch::Tensor candidates =
       loc.bone.index_select(0, c.topk_index.reshape({-1})).reshape({nv, k * loc.bone.size(1)});
-  const torch::Tensor h = torch::cat({loc.vertex, candidates, glob.vertex}, 1);
-  return torch::softmax(head_->forward(h), 1);
+  return torch::softmax(head_->forward(torch::cat({loc.vertex, candidates, glob.vertex}, 1)), 1);
 }
 
 }  // namespace skinlab::experiments

@@ -5,9 +5,6 @@
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
-#include <malloc.h>
-
-#include <climits>
 #include <cstdio>
 #include <iostream>
 #include <string>
@@ -91,12 +88,7 @@ Command add_config(CLI::App& app) {
 }  // namespace skinlab::cli
 
 int main(int argc, char** argv) {
-  // Training allocates and frees the same tensor sizes every step. glibc serves large blocks by
-  // mmap and returns freed heap tops to the kernel, so every step paid for fresh zeroed pages
-  // (measured ~120 ms per 32 MB on this VM). Keeping freed memory in the heap removes that cost;
-  // peak memory is unchanged because the same sizes come back every step.
-  mallopt(M_MMAP_MAX, 0);
-  mallopt(M_TRIM_THRESHOLD, INT_MAX);
+  skinlab::keep_freed_memory();
   skinlab::cli::command_line_storage().assign(argv, argv + argc);
   CLI::App app{"skinlab: learned character skinning (HeterSkinNet and baselines)"};
   app.require_subcommand(1);

@@ -128,7 +128,9 @@ int run(const PredictArgs& args) {
   }
 
   const fs::path model_dir = args.model.empty() ? default_model() : fs::path(args.model);
+  start = Clock::now();
   const predict::Predictor predictor = predict::Predictor::load(model_dir, args.checkpoint);
+  const double model_seconds = std::chrono::duration<double>(Clock::now() - start).count();
   spdlog::info("model: {}", predictor.description());
   const predict::Prediction p = predictor.predict(input, options, &times);
 
@@ -182,9 +184,9 @@ int run(const PredictArgs& args) {
   if (args.timings) {
     std::cout << fmt::format(
         "stages (s): load {:.4f}, normalise {:.4f}, distance {:.4f}, graph {:.4f}, network "
-        "{:.4f}, map back {:.4f}, export {:.4f}\n",
+        "{:.4f}, map back {:.4f}, export {:.4f}; model loading {:.4f}; peak memory {:.0f} MiB\n",
         times.load, times.normalise, times.distance, times.graph, times.network, times.map_back,
-        times.export_);
+        times.export_, model_seconds, peak_memory_mib());
   }
   return 0;
 }

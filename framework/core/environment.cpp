@@ -3,6 +3,7 @@
 #include <ATen/Parallel.h>
 #include <CGAL/version.h>
 #include <H5public.h>
+#include <malloc.h>
 #include <fmt/core.h>
 #include <spdlog/version.h>
 #include <torch/version.h>
@@ -10,6 +11,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <climits>
 #include <cstdio>
 #include <ctime>
 #include <fstream>
@@ -96,6 +98,20 @@ nlohmann::json library_versions() {
                                     NLOHMANN_JSON_VERSION_MINOR, NLOHMANN_JSON_VERSION_PATCH)},
       {"blas", loaded_library("libblas.so.3")},
   };
+}
+
+void keep_freed_memory() {
+  mallopt(M_MMAP_MAX, 0);
+  mallopt(M_TRIM_THRESHOLD, INT_MAX);
+}
+
+double peak_memory_mib() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;  // "… kB"
+  }
+  return 0.0;
 }
 
 int torch_threads() { return at::get_num_threads(); }

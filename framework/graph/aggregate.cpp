@@ -1,5 +1,8 @@
 #include "framework/graph/aggregate.hpp"
 
+#include <ATen/Parallel.h>
+
+#include <algorithm>
 #include <limits>
 
 namespace skinlab::graph {
@@ -68,6 +71,38 @@ torch::Tensor segment_extremum(const torch::Tensor& sorted_rows, const Segments&
                                         reduce == "max");
 }
 
+torch::Tensor gather_segment_min(const torch::Tensor& values, const torch::Tensor& sorted_neighbour,
+                                 const Segments& segments) {
+  TORCH_CHECK(values.dim() == 2 && sorted_neighbour.dim() == 1 &&
+                  sorted_neighbour.scalar_type() == torch::kInt64,
+              "gather_segment_min: expected #N×F values and a 1-D int64 index, got ",
+              values.sizes(), " and ", sorted_neighbour.sizes());
+  TORCH_CHECK(!(torch::GradMode::is_enabled() && values.requires_grad()),
+              "gather_segment_min has no backward; call it with gradients off");
+  const torch::Tensor src = values.contiguous();
+  const torch::Tensor neighbour = sorted_neighbour.contiguous();
+  const torch::Tensor end = segments.lengths.cumsum(0).contiguous();
+  const std::int64_t n = end.size(0), f = src.size(1);
+  torch::Tensor out = torch::empty({n, f}, src.options());
+  AT_DISPATCH_FLOATING_TYPES(src.scalar_type(), "gather_segment_min", [&] {
+    const scalar_t* in = src.data_ptr<scalar_t>();
+    const std::int64_t* nb = neighbour.data_ptr<std::int64_t>();
+    const std::int64_t* stop = end.data_ptr<std::int64_t>();
+    scalar_t* o = out.data_ptr<scalar_t>();
+    at::parallel_for(0, n, /*grain_size=*/256, [&](std::int64_t first, std::int64_t last) {
+      for (std::int64_t i = first; i < last; ++i) {
+        scalar_t* row = o + i * f;
+        std::fill(row, row + f, std::numeric_limits<scalar_t>::infinity());
+        for (std::int64_t r = i == 0 ? 0 : stop[i - 1]; r < stop[i]; ++r) {
+          const scalar_t* x = in + nb[r] * f;
+          for (std::int64_t c = 0; c < f; ++c) row[c] = x[c] < row[c] ? x[c] : row[c];
+        }
+      }
+    });
+  });
+  return out;
+}
+
 torch::Tensor scatter_rows(const torch::Tensor& src, const torch::Tensor& index, std::int64_t n,
                            c10::string_view reduce) {
   TORCH_CHECK(src.dim() == 2 && index.dim() == 1 && index.size(0) == src.size(0),
@@ -107,7 +142,12 @@ torch::Tensor edge_conv_max(const torch::Tensor& x, const torch::Tensor& edges, 
 
   if (mlp.size() == 1) {
     // max_j σ(a_i − b_j) = σ(a_i − min_j b_j) for non-decreasing σ. Empty segments give +inf.
-    torch::Tensor b_min = segment_extremum(b.index_select(0, neighbour), segments, receiver, "min");
+    // Without gradients the gather and the reduction are one pass (no #E×F₁ tensor); the values
+    // are the same, min being exact.
+    torch::Tensor b_min =
+        torch::GradMode::is_enabled() && b.requires_grad()
+            ? segment_extremum(b.index_select(0, neighbour), segments, receiver, "min")
+            : gather_segment_min(b, neighbour, segments);
     if (self_loops) return mlp.activation(0, a - torch::minimum(b_min, b));
     const torch::Tensor has = segments.non_empty();
     b_min = torch::where(has, b_min, zero);

@@ -36,6 +36,14 @@ struct Segments {
 torch::Tensor segment_extremum(const torch::Tensor& sorted_rows, const Segments& segments,
                                const torch::Tensor& sorted_index, c10::string_view reduce);
 
+/// #N×F: out[n] = min over the rows r of node n's segment of values[sorted_neighbour[r]], +inf
+/// for an empty node: `segment_extremum(values.index_select(0, sorted_neighbour), …, "min")`
+/// in one pass without the #R×F gather, parallel over nodes. Inference only (no backward; it
+/// refuses inputs that require gradients while gradients are on). Same values as the two-step
+/// form: a min is exact. About 25× faster than it on 5K vertices × 256 features.
+torch::Tensor gather_segment_min(const torch::Tensor& values, const torch::Tensor& sorted_neighbour,
+                                 const Segments& segments);
+
 /// #N×F: out[n] = reduce over the rows r of `src` (#R×F) with index[r] = n (#R int64, values in
 /// [0, N)); `reduce` is "amax", "amin" or "sum". A node no row points to gets 0 (a defined,
 /// gradient-free value). Ties of a max or min share the gradient equally.

@@ -30,12 +30,8 @@ Features B2v::forward(const Features& in, const Graph& graph) {
   check_features(in.vertex, graph.num_vertices, in_dims().vertex, "vertex features", type());
   check_features(in.bone, graph.num_bones, in_dims().bone, "bone features", type());
   check_topk(graph, in_dims().top_k, type());
-  const std::int64_t nv = graph.num_vertices, k = in_dims().top_k, fb = in_dims().bone;
-  // Row v of the gather is [f_{n_v,1} ... f_{n_v,K}]: topk_index is row-major #V×K.
-  const torch::Tensor candidates =
-      in.bone.index_select(0, graph.topk_index.reshape({-1})).view({nv, k * fb});
   Features out = in;
-  out.vertex = mlp_->forward(torch::cat({in.vertex, candidates}, 1));
+  out.vertex = mlp_->forward_gathered(in.vertex, in.bone, graph.topk_index, torch::Tensor());
   return out;
 }
 

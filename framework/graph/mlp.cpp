@@ -50,4 +50,39 @@ torch::Tensor MlpImpl::forward(torch::Tensor x) {
   return forward_from(0, std::move(x));
 }
 
+torch::Tensor MlpImpl::forward_gathered(const torch::Tensor& own, const torch::Tensor& table,
+                                        const torch::Tensor& index, const torch::Tensor& shared) {
+  TORCH_CHECK(own.dim() == 2 && table.dim() == 2 && index.dim() == 2 &&
+                  index.size(0) == own.size(0) && index.scalar_type() == torch::kInt64,
+              "mlp: forward_gathered expects #V×F own rows, a #B×F table and a #V×K int64 index, "
+              "got ",
+              own.sizes(), ", ", table.sizes(), " and ", index.sizes());
+  const std::int64_t nv = own.size(0), k = index.size(1), f0 = own.size(1), f1 = table.size(1);
+  const std::int64_t f2 = shared.defined() ? shared.size(1) : 0;
+  TORCH_CHECK(!shared.defined() || (shared.dim() == 2 && shared.size(0) == 1),
+              "mlp: forward_gathered expects a 1×F shared row, got ", shared.sizes());
+  TORCH_CHECK(f0 + k * f1 + f2 == in_width_, "mlp: forward_gathered's blocks are ", f0, " + ", k,
+              "×", f1, " + ", f2, " wide, the MLP takes ", in_width_);
+  const bool grad = torch::GradMode::is_enabled() &&
+                    (own.requires_grad() || table.requires_grad() ||
+                     (shared.defined() && shared.requires_grad()) ||
+                     (!linears_.empty() && linears_[0]->weight.requires_grad()));
+  if (grad || linears_.empty()) {
+    std::vector<torch::Tensor> parts{
+        own, table.index_select(0, index.reshape({-1})).view({nv, k * f1})};
+    if (shared.defined()) parts.push_back(shared.expand({nv, f2}));
+    return forward(torch::cat(parts, 1));
+  }
+  const torch::Tensor& w = linears_[0]->weight;  // out × (F₀ + K·F₁ + F₂)
+  const torch::Tensor& bias = linears_[0]->bias;
+  torch::Tensor bias_row = bias.defined() ? bias.view({1, -1}) : torch::zeros({1, w.size(0)}, w.options());
+  if (shared.defined()) bias_row = torch::addmm(bias_row, shared, w.narrow(1, f0 + k * f1, f2).t());
+  torch::Tensor y = torch::addmm(bias_row, own, w.narrow(1, 0, f0).t());
+  for (std::int64_t j = 0; j < k; ++j) {
+    const torch::Tensor per_row = table.matmul(w.narrow(1, f0 + j * f1, f1).t());
+    y.add_(per_row.index_select(0, index.select(1, j)));
+  }
+  return forward_from(1, activation(0, std::move(y)));
+}
+
 }  // namespace skinlab::graph

@@ -41,6 +41,18 @@ class MlpImpl : public torch::nn::Module {
   /// Layers first..n-1 only, on N×width(first-1) input: lets a caller compute layer 0 its own
   /// way (EdgeConv factorises it, edge_conv.hpp) and hand over the activated result.
   torch::Tensor forward_from(std::size_t first, torch::Tensor x);
+  /// The MLP on the rows of [own ‖ table[index(v,0)] ‖ … ‖ table[index(v,K−1)] ‖ shared] for
+  /// #V×F₀ `own`, #B×F₁ `table`, #V×K int64 `index` and an optional 1×F₂ `shared` row (every
+  /// row's; undefined for none): the input of b2v (Eq. 4) and of HeterSkinNet's head.
+  ///
+  /// With gradients on, it forms the concatenation and calls forward, so training is unchanged.
+  /// Without them (prediction, evaluation) layer 0 is split by blocks of its weight:
+  /// own·W₀ᵀ + Σ_k (table·W_kᵀ)[index(·,k)] + shared·W_sᵀ + b. This costs #B and 1 rows
+  /// instead of #V for the gathered and shared blocks, and needs no #V×width concatenation.
+  /// It is the same linear map, but the sums run in another order, so outputs differ from
+  /// forward by float rounding (~1e-6 relative).
+  torch::Tensor forward_gathered(const torch::Tensor& own, const torch::Tensor& table,
+                                 const torch::Tensor& index, const torch::Tensor& shared);
   /// Activation that follows layer `i` (identity for the last layer unless activate_last).
   torch::Tensor activation(std::size_t i, torch::Tensor y) const;
 

@@ -1,6 +1,11 @@
 #include "framework/graph/v2b.hpp"
 
+#include <ATen/Parallel.h>
+
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <vector>
 
 #include "framework/core/registry.hpp"
 #include "framework/graph/aggregate.hpp"
@@ -19,8 +24,71 @@ V2b::Options V2b::Options::from(const config::Node& node) {
   return o;
 }
 
+namespace {
+
+/// pool_vertices_to_bones without autograd: max, then sum → mean, then squared deviations →
+/// var, each accumulated over the pairs in row-major (vertex, candidate) order as index_add
+/// does, for a block of feature columns per thread.
+torch::Tensor pool_without_gradients(const torch::Tensor& x, const torch::Tensor& topk_index,
+                                     std::int64_t num_bones, double variance_scale) {
+  const torch::Tensor xs = x.contiguous();
+  const torch::Tensor index = topk_index.contiguous();
+  const std::int64_t nv = xs.size(0), k = index.size(1), f = xs.size(1);
+  std::vector<std::int64_t> count(static_cast<std::size_t>(num_bones), 0);
+  const std::int64_t* bone = index.data_ptr<std::int64_t>();
+  for (std::int64_t r = 0; r < nv * k; ++r) ++count[static_cast<std::size_t>(bone[r])];
+  torch::Tensor out = torch::zeros({num_bones, 3 * f}, xs.options());
+  AT_DISPATCH_FLOATING_TYPES(xs.scalar_type(), "pool_vertices_to_bones", [&] {
+    const scalar_t* in = xs.data_ptr<scalar_t>();
+    scalar_t* o = out.data_ptr<scalar_t>();
+    const scalar_t scale = static_cast<scalar_t>(variance_scale);
+    at::parallel_for(0, f, /*grain_size=*/32, [&](std::int64_t c0, std::int64_t c1) {
+      const auto cell = [&](std::int64_t b, std::int64_t part, std::int64_t c) -> scalar_t& {
+        return o[b * 3 * f + part * f + c];
+      };
+      for (std::int64_t b = 0; b < num_bones; ++b) {
+        for (std::int64_t c = c0; c < c1; ++c) {
+          cell(b, 0, c) = -std::numeric_limits<scalar_t>::infinity();
+        }
+      }
+      for (std::int64_t r = 0; r < nv * k; ++r) {
+        const scalar_t* row = in + (r / k) * f;
+        for (std::int64_t c = c0; c < c1; ++c) {
+          scalar_t& m = cell(bone[r], 0, c);
+          m = row[c] > m ? row[c] : m;
+          cell(bone[r], 1, c) += row[c];
+        }
+      }
+      for (std::int64_t b = 0; b < num_bones; ++b) {
+        const auto n = static_cast<scalar_t>(std::max<std::int64_t>(count[b], 1));
+        for (std::int64_t c = c0; c < c1; ++c) {
+          if (count[b] == 0) cell(b, 0, c) = 0;
+          cell(b, 1, c) /= n;
+        }
+      }
+      for (std::int64_t r = 0; r < nv * k; ++r) {
+        const scalar_t* row = in + (r / k) * f;
+        for (std::int64_t c = c0; c < c1; ++c) {
+          const scalar_t d = row[c] - cell(bone[r], 1, c);
+          cell(bone[r], 2, c) += d * d;
+        }
+      }
+      for (std::int64_t b = 0; b < num_bones; ++b) {
+        const auto n = static_cast<scalar_t>(std::max<std::int64_t>(count[b], 1));
+        for (std::int64_t c = c0; c < c1; ++c) cell(b, 2, c) = cell(b, 2, c) / n * scale;
+      }
+    });
+  });
+  return out;
+}
+
+}  // namespace
+
 torch::Tensor pool_vertices_to_bones(const torch::Tensor& x, const torch::Tensor& topk_index,
                                      std::int64_t num_bones, double variance_scale) {
+  if (!(torch::GradMode::is_enabled() && x.requires_grad())) {
+    return pool_without_gradients(x, topk_index, num_bones, variance_scale);
+  }
   const std::int64_t nv = x.size(0), k = topk_index.size(1), f = x.size(1);
   // One row per (vertex, candidate) pair: the vertex's feature, sent to the candidate bone.
   const torch::Tensor bone = topk_index.reshape({-1});

@@ -54,7 +54,10 @@ class V2b final : public GraphOp {
 
 /// #B×3F: [max ‖ mean ‖ variance_scale · var] of the vertex features `x` (#V×F) over I(b) for each
 /// bone b, from `topk_index` (#V×K, validated); zeros for a bone with I(b) = ∅. The pooling half
-/// of `v2b`, exposed for tests and for models that pool without an MLP.
+/// of `v2b`, exposed for tests and for models that pool without an MLP. Without gradients
+/// (prediction, evaluation) it is one pass over the (vertex, candidate) pairs per statistic,
+/// parallel over feature columns, with no #V·K×F row tensor; the sums run in the same order, so
+/// the values are those of the differentiable form.
 torch::Tensor pool_vertices_to_bones(const torch::Tensor& x, const torch::Tensor& topk_index,
                                      std::int64_t num_bones, double variance_scale);
 

@@ -82,6 +82,23 @@ TEST(V2b, MatchesLoopReference) {
   EXPECT_EQ(make_op("{type: v2b, mlp: []}", t.dims)->out_dims().bone, 2 + 3 * 3);
 }
 
+TEST(V2b, PoolingWithoutGradientsGivesTheSameValues) {
+  // Prediction's single-pass kernel against the differentiable form, on a random #V×K index
+  // with bones no vertex picks, in both float types: equal, since the sums run in one order.
+  torch::manual_seed(5);
+  const int64_t nv = 200, nb = 30, k = 3;
+  const torch::Tensor index = torch::randint(0, nb - 4, {nv, k}, torch::kInt64);
+  for (torch::ScalarType dtype : {torch::kFloat32, torch::kFloat64}) {
+    const torch::Tensor x = torch::randn({nv, 70}, dtype).requires_grad_(true);
+    const torch::Tensor tracked = pool_vertices_to_bones(x, index, nb, 0.5);
+    ASSERT_TRUE(tracked.requires_grad());
+    torch::NoGradGuard no_grad;
+    const torch::Tensor fast = pool_vertices_to_bones(x, index, nb, 0.5);
+    EXPECT_TRUE(torch::equal(fast, tracked)) << (fast - tracked).abs().max().item<double>();
+    EXPECT_EQ(fast.slice(0, nb - 4).abs().max().item<double>(), 0.0);  // unpicked bones
+  }
+}
+
 TEST(V2b, NoGradientThroughAnUninfluencedBoneAndTopkErrors) {
   TinyGraph t = tiny_graph(3, 2);
   auto op = make_op("{type: v2b, mlp: [4]}", t.dims);
@@ -114,12 +131,44 @@ TEST(B2v, MatchesLoopReferenceInCandidateOrder) {
     const Features out = op->forward(t.features, t.graph);
     EXPECT_TRUE(torch::allclose(out.vertex, torch::stack(rows), 1e-10, 1e-12)) << options;
     EXPECT_TRUE(torch::equal(out.bone, t.features.bone));
+    // without gradients layer 0 is split by weight blocks (Mlp::forward_gathered)
+    torch::NoGradGuard no_grad;
+    EXPECT_TRUE(torch::allclose(op->forward(t.features, t.graph).vertex, torch::stack(rows),
+                                1e-10, 1e-12))
+        << options;
   }
   // without an MLP: vertex 1 (candidates 1, 0) is [f_v1 ‖ f_b1 ‖ f_b0]
   auto cat = make_op("{type: b2v, mlp: []}", t.dims);
   EXPECT_TRUE(
       torch::equal(cat->forward(t.features, t.graph).vertex[1],
                    torch::cat({t.features.vertex[1], t.features.bone[1], t.features.bone[0]})));
+}
+
+TEST(Mlp, ForwardGatheredIsTheMlpOfTheConcatenation) {
+  torch::manual_seed(3);
+  const int64_t nv = 9, nb = 4, k = 3;
+  const torch::Tensor own = torch::randn({nv, 5}, torch::kFloat64);
+  const torch::Tensor table = torch::randn({nb, 2}, torch::kFloat64);
+  const torch::Tensor index = torch::randint(0, nb, {nv, k}, torch::kInt64);
+  const torch::Tensor shared = torch::randn({1, 4}, torch::kFloat64);
+  const torch::Tensor gathered = table.index_select(0, index.reshape({-1})).view({nv, k * 2});
+  for (const bool with_shared : {true, false}) {
+    Mlp mlp(5 + k * 2 + (with_shared ? 4 : 0), MlpOptions{{6, 3}});
+    mlp->to(torch::kFloat64);
+    std::vector<torch::Tensor> parts{own, gathered};
+    if (with_shared) parts.push_back(shared.expand({nv, 4}));
+    const torch::Tensor expected = mlp->forward(torch::cat(parts, 1));
+    const torch::Tensor s = with_shared ? shared : torch::Tensor();
+    // with gradients: the concatenation itself, so training is unchanged to the bit
+    EXPECT_TRUE(torch::equal(mlp->forward_gathered(own, table, index, s), expected));
+    torch::NoGradGuard no_grad;
+    EXPECT_TRUE(torch::allclose(mlp->forward_gathered(own, table, index, s), expected, 1e-12,
+                                1e-12));
+  }
+  Mlp wrong(7, MlpOptions{{2}});
+  wrong->to(torch::kFloat64);
+  expect_error<c10::Error>([&] { wrong->forward_gathered(own, table, index, shared); },
+                           {"5 + 3×2 + 4 wide", "takes 7"});
 }
 
 TEST(B2v, TopkErrorsNameTheVertex) {

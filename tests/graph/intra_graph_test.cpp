@@ -65,6 +65,22 @@ TEST_P(EdgeConvVsNaive, GradientsMatchFiniteDifferences) {
   expect_gradients_match(*op, t.features, t.graph);
 }
 
+TEST_P(EdgeConvVsNaive, WithoutGradientsTheSameValues) {
+  // Prediction and evaluation run without gradients, where a one-layer MLP takes the fused
+  // gather-min kernel (gather_segment_min): a min is exact, so the values are equal, not close.
+  const auto& c = GetParam();
+  const TinyGraph t = tiny_graph(3, 2);
+  auto op = make_op("{type: edge_conv, edges: " + c.set + ", mlp: " + c.mlp +
+                        ", self_loops: " + (c.self_loops ? "true" : "false") + "}",
+                    t.dims);
+  const Features trained = op->forward(t.features, t.graph);
+  ASSERT_TRUE((c.set == "skeleton" ? trained.bone : trained.vertex).requires_grad());
+  torch::NoGradGuard no_grad;
+  const Features inferred = op->forward(t.features, t.graph);
+  EXPECT_TRUE(torch::equal(inferred.vertex, trained.vertex));
+  EXPECT_TRUE(torch::equal(inferred.bone, trained.bone));
+}
+
 INSTANTIATE_TEST_SUITE_P(EdgeConv, EdgeConvVsNaive,
                          ::testing::Values(EdgeConvCase{"one_ring", "[5]", true},
                                            EdgeConvCase{"one_ring", "[5, 4]", true},
@@ -94,6 +110,28 @@ TEST(EdgeConv, LargerRandomGraphMatchesNaive) {
         out.vertex, naive_edge_conv(x, g.geodesic, mlp_of(*op, "mlp"), true), 1e-10, 1e-12))
         << mlp;
   }
+}
+
+TEST(GatherSegmentMin, EqualsGatherThenSegmentMinAndRefusesGradients) {
+  torch::manual_seed(9);
+  const int64_t n = 50;
+  // unsorted; nodes 40..49 get no row
+  const torch::Tensor index = torch::randint(0, n - 10, {300}, torch::kInt64);
+  const torch::Tensor neighbour = torch::randint(0, n, {300}, torch::kInt64);
+  const Segments s = Segments::of(index, n);
+  for (torch::ScalarType dtype : {torch::kFloat32, torch::kFloat64}) {
+    const torch::Tensor values = torch::randn({n, 7}, dtype);
+    const torch::Tensor expected = segment_extremum(
+        values.index_select(0, s.sorted_index(neighbour)), s, s.sorted_index(index), "min");
+    const torch::Tensor got = gather_segment_min(values, s.sorted_index(neighbour), s);
+    EXPECT_TRUE(torch::equal(got, expected));
+    const torch::Tensor empty = s.lengths == 0;
+    ASSERT_GT(empty.sum().item<int64_t>(), 0);  // the case of a node without rows is covered
+    EXPECT_TRUE(torch::isinf(got.index({empty})).all().item<bool>());
+  }
+  const torch::Tensor tracked = torch::randn({n, 2}, torch::requires_grad());
+  expect_error<c10::Error>([&] { gather_segment_min(tracked, s.sorted_index(neighbour), s); },
+                           {"no backward"});
 }
 
 TEST(EdgeConv, EdgeOrderDoesNotMatter) {

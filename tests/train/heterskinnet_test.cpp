@@ -59,6 +59,17 @@ TEST(HeterSkinNet, TrainsLossDecreasesAndPredictsValidWeights) {
   EXPECT_TRUE(((full > 0).sum(1) <= 3).all().item<bool>());
   // Eval mode is deterministic (no edge or head dropout).
   EXPECT_TRUE(torch::equal(w, trainer.model().forward(c)));
+  // Without gradients b2v and the head split their first layer by weight blocks and EdgeConv
+  // fuses its gather and min; with them the network runs as in training. Same weights up to
+  // float rounding.
+  torch::Tensor tracked;
+  {
+    torch::GradMode::set_enabled(true);
+    tracked = trainer.model().forward(c);
+    torch::GradMode::set_enabled(false);
+  }
+  ASSERT_TRUE(tracked.requires_grad());
+  EXPECT_TRUE(torch::allclose(w, tracked.detach(), 1e-5, 1e-6));
 }
 
 // The paper-width network as initialised (Kaiming normal) must start from soft predictions: with
