@@ -2,6 +2,8 @@
 
 #include <tiny_gltf.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cstring>
 #include <limits>
@@ -99,16 +101,43 @@ void write_gltf(const std::filesystem::path& file, const Character& character,
   model.asset.generator = "skinlab";
   model.buffers.emplace_back();
 
-  // Joints: node j is joint j, translated from its parent.
+  // Joints: node j is joint j, its +Y turned towards its children (see the header).
   const auto children = skeleton.children();
+  std::vector<Eigen::Matrix3d> rotation(static_cast<std::size_t>(nj));
+  std::vector<int> parents_first{skeleton.root()};
+  for (std::size_t i = 0; i < parents_first.size(); ++i) {
+    for (int c : children[parents_first[i]]) parents_first.push_back(c);
+  }
+  for (int j : parents_first) {
+    const int p = skeleton.parents[j];
+    Eigen::Vector3d towards = Eigen::Vector3d::Zero();
+    for (int c : children[j]) {
+      towards += (skeleton.positions.row(c) - skeleton.positions.row(j)).transpose();
+    }
+    const Eigen::Matrix3d inherited =
+        p < 0 ? Eigen::Matrix3d::Identity() : rotation[static_cast<std::size_t>(p)];
+    rotation[static_cast<std::size_t>(j)] =
+        towards.norm() > 1e-9 * (1.0 + skeleton.positions.row(j).norm())
+            ? Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitY(), towards)
+                  .toRotationMatrix()
+            : inherited;
+  }
   for (int j = 0; j < nj; ++j) {
     tinygltf::Node node;
     node.name = skeleton.names[j];
     const int p = skeleton.parents[j];
-    const Eigen::Vector3d local = p < 0 ? Eigen::Vector3d(skeleton.positions.row(j))
-                                        : Eigen::Vector3d(skeleton.positions.row(j) -
-                                                          skeleton.positions.row(p));
+    const Eigen::Matrix3d& r = rotation[static_cast<std::size_t>(j)];
+    const Eigen::Vector3d position = skeleton.positions.row(j).transpose();
+    Eigen::Vector3d local = position;
+    Eigen::Matrix3d local_rotation = r;
+    if (p >= 0) {
+      const Eigen::Matrix3d& rp = rotation[static_cast<std::size_t>(p)];
+      local = rp.transpose() * (position - skeleton.positions.row(p).transpose());
+      local_rotation = rp.transpose() * r;
+    }
     node.translation = {local.x(), local.y(), local.z()};
+    const Eigen::Quaterniond q(local_rotation);
+    if (!local_rotation.isIdentity(1e-12)) node.rotation = {q.x(), q.y(), q.z(), q.w()};
     node.children.assign(children[j].begin(), children[j].end());
     model.nodes.push_back(std::move(node));
   }
@@ -195,15 +224,20 @@ void write_gltf(const std::filesystem::path& file, const Character& character,
   gltf_mesh.primitives.push_back(std::move(primitive));
   model.meshes.push_back(std::move(gltf_mesh));
 
-  // Skin: inverse bind matrices (column-major) of pure translations.
+  // Skin: inverse bind matrices G_j⁻¹ = [R_jᵀ | −R_jᵀ p_j], column-major.
   std::vector<float> ibm(static_cast<std::size_t>(nj) * 16, 0.0f);
   tinygltf::Skin skin;
   skin.name = character.name + "_skin";
   skin.skeleton = skeleton.root();
   for (int j = 0; j < nj; ++j) {
+    const Eigen::Matrix3d rt = rotation[static_cast<std::size_t>(j)].transpose();
+    const Eigen::Vector3d t = -rt * skeleton.positions.row(j).transpose();
     float* m = ibm.data() + static_cast<std::size_t>(j) * 16;
-    m[0] = m[5] = m[10] = m[15] = 1.0f;
-    for (int a = 0; a < 3; ++a) m[12 + a] = static_cast<float>(-skeleton.positions(j, a));
+    for (int c = 0; c < 3; ++c) {
+      for (int r = 0; r < 3; ++r) m[c * 4 + r] = static_cast<float>(rt(r, c));
+      m[12 + c] = static_cast<float>(t(c));
+    }
+    m[15] = 1.0f;
     skin.joints.push_back(j);
   }
   skin.inverseBindMatrices =

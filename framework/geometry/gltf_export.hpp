@@ -6,11 +6,16 @@
 /// other glTF importer.
 ///
 /// Layout of the asset:
-///   - one node per joint, in skeleton order (node j is joint j), each with its translation
-///     relative to its parent joint and no rotation or scale, so that joint j's global transform
-///     is the translation to its position: the skeleton is in its bind pose;
+///   - one node per joint, in skeleton order (node j is joint j), in its bind pose: joint j's
+///     global transform G_j = [R_j | p_j] puts it at its position p_j, and R_j turns the local +Y
+///     axis towards the centroid of its children (the shortest such rotation; a leaf, or a joint
+///     whose children all sit on it, keeps its parent's R; the root's parent R is the identity).
+///     glTF stores joints, not bones; importers draw and bind a joint's bone along its local +Y
+///     (Blender 3.4's default "Blender" bone heuristic does), so without R every bone would
+///     point up and Blender's automatic weights would follow those wrong bones. Nodes carry the
+///     local translation and rotation G_parent⁻¹ G_j, no scale;
 ///   - one skin over those nodes, `skeleton` = the root joint, inverse bind matrices
-///     IBM_j = translate(−p_j) (the inverse of the joint's global transform, Sec. 3.7.3.1);
+///     IBM_j = G_j⁻¹ (Sec. 3.7.3.1), so the bind pose leaves every vertex where it is;
 ///   - one mesh node carrying the mesh and the skin (its own transform is the identity, as the
 ///     specification asks of skinned mesh nodes); the scene's roots are the root joint and the
 ///     mesh node;

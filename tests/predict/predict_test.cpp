@@ -2,6 +2,9 @@
 // out, mapped back to its own vertices and joints; glTF export re-imported through assimp.
 
 #include <gtest/gtest.h>
+#include <tiny_gltf.h>
+
+#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <map>
@@ -247,6 +250,77 @@ TEST(GltfExport, PredictionReimportsWithTheSameBonesAndWeights) {
   for (const char* name : {"player.glb", "player.gltf"}) {
     geometry::write_gltf(dir / name, out);
     expect_gltf_round_trip(dir / name, out);
+  }
+}
+
+TEST(GltfExport, JointsPointTheirYAxisAtTheirChildrenAndBindToIdentity) {
+  // A branching skeleton: root → spine (up) → two arms (sideways) with a leaf each, and a joint
+  // whose only child sits on it.
+  geometry::Character c;
+  c.name = "branch";
+  c.mesh = testing::grid(3, 3, 0.1);
+  Eigen::MatrixXd J(6, 3);
+  J << 0, 0, 0,  0, 1, 0,  1, 1, 0,  -1, 1.5, 0,  2, 1, 1,  2, 1, 1;
+  c.skeleton = geometry::Skeleton::from_parent_names({"root", "spine", "r_arm", "l_arm", "r_hand",
+                                                      "r_tip"},
+                                                     J, {"", "root", "spine", "spine", "r_arm",
+                                                         "r_hand"},
+                                                     "branch");
+  Eigen::MatrixXd W = Eigen::MatrixXd::Constant(c.mesh.num_vertices(), 6, 1.0 / 6);
+  c.weights = W.sparseView();
+  TempDir dir;
+  geometry::write_gltf(dir / "branch.gltf", c);
+
+  tinygltf::Model model;
+  tinygltf::TinyGLTF loader;
+  std::string err, warn;
+  const std::string json = read_file(dir / "branch.gltf");  // the buffer is a data URI
+  ASSERT_TRUE(loader.LoadASCIIFromString(&model, &err, &warn, json.data(),
+                                         static_cast<unsigned>(json.size()), ""))
+      << err;
+  const auto local = [&](int j) {
+    const tinygltf::Node& n = model.nodes.at(static_cast<std::size_t>(j));
+    Eigen::Affine3d t = Eigen::Affine3d::Identity();
+    if (!n.translation.empty()) {
+      t.translate(Eigen::Vector3d(n.translation[0], n.translation[1], n.translation[2]));
+    }
+    if (!n.rotation.empty()) {
+      t.rotate(Eigen::Quaterniond(n.rotation[3], n.rotation[0], n.rotation[1], n.rotation[2]));
+    }
+    EXPECT_TRUE(n.scale.empty() && n.matrix.empty());
+    return t;
+  };
+  std::vector<Eigen::Affine3d> global(6);
+  for (int j = 0; j < 6; ++j) {  // parents come first in this skeleton
+    const int p = c.skeleton.parents[j];
+    global[j] = p < 0 ? local(j) : global[p] * local(j);
+  }
+  const tinygltf::Accessor& a = model.accessors.at(model.skins.at(0).inverseBindMatrices);
+  const tinygltf::BufferView& view = model.bufferViews.at(a.bufferView);
+  const auto* ibm = reinterpret_cast<const float*>(
+      model.buffers.at(view.buffer).data.data() + view.byteOffset + a.byteOffset);
+  const Eigen::Vector3d y = Eigen::Vector3d::UnitY();
+  const auto direction = [&](int j) { return (global[j].linear() * y).eval(); };
+  for (int j = 0; j < 6; ++j) {
+    EXPECT_LT((global[j].translation() - J.row(j).transpose()).norm(), 1e-9) << j;
+    EXPECT_LT((global[j].linear() * global[j].linear().transpose() -
+               Eigen::Matrix3d::Identity()).norm(), 1e-9) << j;
+    Eigen::Matrix4d inverse_bind;
+    for (int k = 0; k < 16; ++k) inverse_bind(k % 4, k / 4) = ibm[16 * j + k];
+    EXPECT_LT((inverse_bind * global[j].matrix() - Eigen::Matrix4d::Identity()).norm(), 1e-5)
+        << j;
+  }
+  EXPECT_LT((direction(0) - y).norm(), 1e-9);                                 // towards spine
+  EXPECT_LT((direction(1) - Eigen::Vector3d(0, 0.25, 0).normalized()).norm(), 1e-9);  // centroid
+  EXPECT_LT((direction(2) - Eigen::Vector3d(1, 0, 1).normalized()).norm(), 1e-9);      // hand
+  EXPECT_LT((direction(3) - direction(1)).norm(), 1e-9);  // a leaf keeps its parent's
+  EXPECT_LT((direction(4) - direction(2)).norm(), 1e-9);  // its child sits on it
+  // assimp reads the joints back where they were (in its own depth-first order)
+  const geometry::Character back = geometry::import_character(dir / "branch.gltf");
+  for (int j = 0; j < 6; ++j) {
+    const int b = back.skeleton.find(c.skeleton.names[j]);
+    ASSERT_GE(b, 0) << c.skeleton.names[j];
+    EXPECT_LT((back.skeleton.positions.row(b) - J.row(j)).norm(), 1e-6) << c.skeleton.names[j];
   }
 }
 
