@@ -228,14 +228,16 @@ namespace {
 /// method's weights (RigNet rig text, or a glTF/any assimp file of the same mesh) against the
 /// character's own (artist) weights, joints matched by name.
 int run_score(const std::string& input, const std::string& rig, const std::string& weights,
-              const std::string& model) {
+              const std::string& model, bool allow_unweighted) {
   const geometry::Character truth = geometry::load_character(input, rig);
   if (!truth.has_weights()) throw Error(input + ": carries no skin weights to score against");
   const fs::path file = weights;
   geometry::Skeleton other_skeleton;
   geometry::SparseWeights other;
   if (file.extension() == ".txt") {
-    geometry::Rig r = geometry::read_rig(file, truth.mesh.num_vertices());
+    geometry::WeightCheck check;
+    check.allow_unweighted = allow_unweighted;
+    geometry::Rig r = geometry::read_rig(file, truth.mesh.num_vertices(), check);
     other_skeleton = r.skeleton;
     other = r.weights;
   } else {
@@ -263,11 +265,23 @@ int run_score(const std::string& input, const std::string& rig, const std::strin
   }
   geometry::SparseWeights mapped(truth.mesh.num_vertices(), truth.skeleton.num_joints());
   mapped.setFromTriplets(entries.begin(), entries.end());
+  int unweighted = 0;
   for (Eigen::Index v = 0; v < mapped.rows(); ++v) {
     if (!(mapped.row(v).sum() > 0)) {
-      throw Error(fmt::format("{}: vertex {} has no weight", weights, v));
+      if (!allow_unweighted) {
+        throw Error(fmt::format("{}: vertex {} has no weight (--allow-unweighted scores it as "
+                                "predicting no bone)",
+                                weights, v));
+      }
+      ++unweighted;
+      continue;
     }
     mapped.row(v) /= mapped.row(v).sum();
+  }
+  if (unweighted > 0) {
+    std::cout << fmt::format("{}: {} of {} vertices have no weight; scored as predicting no bone "
+                             "(their linear blend skinning puts them at the origin)\n",
+                             weights, unweighted, mapped.rows());
   }
   const fs::path model_dir = model.empty() ? default_model() : fs::path(model);
   const predict::Predictor predictor = predict::Predictor::load(model_dir);
@@ -294,7 +308,11 @@ Command add_score(CLI::App& app) {
       ->required();
   cmd->add_option("--model", *model,
                   "model whose preparation and metrics are used (default: the bundled one)");
-  return {cmd, [=] { return run_score(*input, *rig, *weights, *model); }};
+  auto allow_unweighted = std::make_shared<bool>(false);
+  cmd->add_flag("--allow-unweighted", *allow_unweighted,
+                "score vertices the other method left without weight as predicting no bone "
+                "instead of refusing the file");
+  return {cmd, [=] { return run_score(*input, *rig, *weights, *model, *allow_unweighted); }};
 }
 
 Command add_bundle(CLI::App& app) {

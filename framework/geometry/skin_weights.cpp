@@ -27,7 +27,10 @@ void check_weights(SparseWeights& W, int num_vertices, const Skeleton& skeleton,
       }
       sum += it.value();
     }
-    if (sum <= 0) throw GeometryError(at + "vertex " + std::to_string(v) + " has no weight");
+    if (sum <= 0) {
+      if (options.allow_unweighted) continue;
+      throw GeometryError(at + "vertex " + std::to_string(v) + " has no weight");
+    }
     if (std::abs(sum - 1.0) > options.tolerance) {
       if (!options.renormalise) {
         throw GeometryError(at + "vertex " + std::to_string(v) + ": weights sum to " +

@@ -20,11 +20,15 @@ using SparseWeights = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 struct WeightCheck {
   double tolerance = 1e-3;   ///< |row sum − 1| allowed
   bool renormalise = false;  ///< divide rows by their sum instead of rejecting them
+  /// Keep a vertex with no weight as an empty row instead of rejecting it: only for scoring
+  /// another method's output that leaves vertices unweighted (Blender's automatic weights do).
+  bool allow_unweighted = false;
 };
 
 /// Checks (and with `renormalise`, fixes) per-vertex weights W (#V×#J). Throws GeometryError,
 /// prefixed by `source`, naming the vertex and joint for: a shape other than
-/// num_vertices×num_joints, non-finite or negative weights, a vertex with no weight, and (unless
+/// num_vertices×num_joints, non-finite or negative weights, a vertex with no weight (unless
+/// `allow_unweighted`), and (unless
 /// renormalising) a row whose sum differs from 1 by more than the tolerance. Explicit zeros are
 /// pruned.
 void check_weights(SparseWeights& W, int num_vertices, const Skeleton& skeleton,

@@ -192,6 +192,25 @@ TEST(PredictCli, GameCharacterExportedFromItsSourceIsSkinnedAndRendered) {
   const Result other = run("score " + horse.string() + " --weights " + kPlayer);
   EXPECT_EQ(other.status, 1);
   EXPECT_NE(other.err.find("vertices, but"), std::string::npos) << other.err;
+  // A method that leaves a vertex without weight (Blender's automatic weights do): refused,
+  // or with --allow-unweighted scored as predicting no bone, and said so.
+  const fs::path holed = dir / "holed_rig.txt";
+  geometry::write_rig(holed, artist.skeleton, artist.weights);
+  std::string text = read_file(holed);
+  const auto line = text.find("\nskin 0 ");
+  ASSERT_NE(line, std::string::npos);
+  text.erase(line, text.find('\n', line + 1) - line);
+  write_file_atomic(holed, text);
+  const Result refused = run("score " + horse.string() + " --weights " + holed.string());
+  EXPECT_EQ(refused.status, 1);
+  EXPECT_NE(refused.err.find("vertex 0 has no weight"), std::string::npos) << refused.err;
+  const Result allowed =
+      run("score " + horse.string() + " --allow-unweighted --weights " + holed.string());
+  ASSERT_EQ(allowed.status, 0) << allowed.err;
+  EXPECT_NE(allowed.out.find("1 of " + std::to_string(artist.mesh.num_vertices()) +
+                             " vertices have no weight"),
+            std::string::npos)
+      << allowed.out;
 
   const Result missing = run("export configs/datasets/zeroad_bundled.yaml unicorn --out " +
                              (dir / "u.glb").string());

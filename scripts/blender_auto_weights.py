@@ -1,0 +1,95 @@
+# Blender's own "automatic weights" (Object ▸ Parent ▸ With Automatic Weights, i.e. bone heat,
+# Baran & Popović 2007) on a skinned glTF, headless:
+#
+#   blender -b --factory-startup --python scripts/blender_auto_weights.py -- \
+#       hero.glb hero_artist_rig.txt hero_blender_rig.txt [all|weighted]
+#
+# Imports the glTF with Blender's defaults, writes the weights as imported (the artist's, a check
+# that vertex order and joint names survive the trip), removes them and the armature binding,
+# parents the mesh to the armature with automatic weights, and writes those. With `all` (the
+# default, what a user gets on import) every joint is a deform bone; game skeletons carry prop,
+# attachment and IK-helper joints (0 A.D.'s weapon_bow, quiver_R, elbow_L under the hip...), and
+# Blender gives them weight. With `weighted` only the joints the artist weighted stay deform bones,
+# as an artist would set up the rig by hand. Both files are
+# RigNet rig text in the glTF's frame (Y up); vertices Blender leaves without weight get no
+# `skin` line (`skinlab score --allow-unweighted` reads that). Prints IMPORT_S, SOLVE_S (the
+# parent_set call alone), VERTICES and UNWEIGHTED lines for scripts/compare_blender.
+#
+# Blender 3.4's glTF importer still uses numpy.bool, which numpy 1.24 (Debian 12) removed.
+import numpy
+
+if not hasattr(numpy, "bool"):
+    numpy.bool = bool
+
+import sys
+import time
+
+import bpy
+
+
+def write_rig(path, armature, mesh):
+    """Joints are bone heads; Blender's Z-up world (x, y, z) is glTF's (x, z, −y)."""
+    bones = armature.data.bones
+    groups = {g.index: g.name for g in mesh.vertex_groups}
+    unweighted = 0
+    with open(path, "w") as f:
+        for b in bones:
+            h = armature.matrix_world @ b.head_local
+            f.write(f"joints {b.name} {h.x:.6f} {h.z:.6f} {-h.y:.6f}\n")
+        roots = [b for b in bones if b.parent is None]
+        f.write(f"root {roots[0].name}\n")
+        for b in bones:
+            if b.parent is not None:
+                f.write(f"hier {b.parent.name} {b.name}\n")
+        for v in mesh.data.vertices:
+            weights = [(groups[g.group], g.weight) for g in v.groups if g.weight > 0]
+            if not weights:
+                unweighted += 1
+                continue
+            total = sum(w for _, w in weights)
+            pairs = " ".join(f"{name} {w / total:.7f}" for name, w in weights)
+            f.write(f"skin {v.index} {pairs}\n")
+    return unweighted
+
+
+def main():
+    args = sys.argv[sys.argv.index("--") + 1:]
+    source, artist_out, auto_out = args[:3]
+    deform = args[3] if len(args) > 3 else "all"
+    if deform not in ("all", "weighted"):
+        raise SystemExit(f"unknown deform set '{deform}': choose all or weighted")
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    start = time.perf_counter()
+    bpy.ops.import_scene.gltf(filepath=source)
+    print(f"IMPORT_S {time.perf_counter() - start:.4f}")
+    armature = next(o for o in bpy.data.objects if o.type == "ARMATURE")
+    meshes = [o for o in bpy.data.objects if o.type == "MESH"]
+    if len(meshes) != 1:
+        raise SystemExit(f"{source}: {len(meshes)} meshes; expected one")
+    mesh = meshes[0]
+    print(f"VERTICES {len(mesh.data.vertices)}")
+    write_rig(artist_out, armature, mesh)
+
+    if deform == "weighted":
+        weighted = {mesh.vertex_groups[g.group].name
+                    for v in mesh.data.vertices for g in v.groups if g.weight > 0}
+        for b in armature.data.bones:
+            b.use_deform = b.name in weighted
+        print(f"DEFORM_BONES {len(weighted)} of {len(armature.data.bones)}")
+    mesh.vertex_groups.clear()
+    for modifier in [m for m in mesh.modifiers if m.type == "ARMATURE"]:
+        mesh.modifiers.remove(modifier)
+    world = mesh.matrix_world.copy()
+    mesh.parent = None
+    mesh.matrix_world = world
+    bpy.ops.object.select_all(action="DESELECT")
+    mesh.select_set(True)
+    armature.select_set(True)
+    bpy.context.view_layer.objects.active = armature
+    start = time.perf_counter()
+    bpy.ops.object.parent_set(type="ARMATURE_AUTO")
+    print(f"SOLVE_S {time.perf_counter() - start:.4f}")
+    print(f"UNWEIGHTED {write_rig(auto_out, armature, mesh)}")
+
+
+main()
