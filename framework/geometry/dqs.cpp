@@ -2,6 +2,8 @@
 
 #include <string>
 
+#include "framework/geometry/lbs.hpp"
+
 namespace skinlab::geometry {
 
 namespace {
@@ -36,14 +38,7 @@ DualQuaternion from_rigid(const Eigen::Affine3d& t, int joint) {
 
 Eigen::MatrixXd dqs(const Eigen::MatrixXd& V, const SparseWeights& W,
                     const std::vector<Eigen::Affine3d>& T) {
-  if (V.cols() != 3) {
-    throw GeometryError("dqs: V must be #V×3, got " + std::to_string(V.cols()) + " columns");
-  }
-  if (W.rows() != V.rows() || W.cols() != static_cast<Eigen::Index>(T.size())) {
-    throw GeometryError("dqs: weights are " + std::to_string(W.rows()) + "×" +
-                        std::to_string(W.cols()) + ", expected #V×#J = " +
-                        std::to_string(V.rows()) + "×" + std::to_string(T.size()));
-  }
+  check_skinning_inputs("dqs", V, W, T);
   std::vector<DualQuaternion> q;
   q.reserve(T.size());
   for (std::size_t j = 0; j < T.size(); ++j) q.push_back(from_rigid(T[j], static_cast<int>(j)));

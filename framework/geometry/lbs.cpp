@@ -6,16 +6,22 @@
 
 namespace skinlab::geometry {
 
-Eigen::MatrixXd lbs(const Eigen::MatrixXd& V, const SparseWeights& W,
-                    const std::vector<Eigen::Affine3d>& T) {
+void check_skinning_inputs(const char* who, const Eigen::MatrixXd& V, const SparseWeights& W,
+                           const std::vector<Eigen::Affine3d>& T) {
   if (V.cols() != 3) {
-    throw GeometryError("lbs: V must be #V×3, got " + std::to_string(V.cols()) + " columns");
+    throw GeometryError(std::string(who) + ": V must be #V×3, got " + std::to_string(V.cols()) +
+                        " columns");
   }
   if (W.rows() != V.rows() || W.cols() != static_cast<Eigen::Index>(T.size())) {
-    throw GeometryError("lbs: weights are " + std::to_string(W.rows()) + "×" +
+    throw GeometryError(std::string(who) + ": weights are " + std::to_string(W.rows()) + "×" +
                         std::to_string(W.cols()) + ", expected #V×#J = " +
                         std::to_string(V.rows()) + "×" + std::to_string(T.size()));
   }
+}
+
+Eigen::MatrixXd lbs(const Eigen::MatrixXd& V, const SparseWeights& W,
+                    const std::vector<Eigen::Affine3d>& T) {
+  check_skinning_inputs("lbs", V, W, T);
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(V.rows(), 3);
   for (Eigen::Index i = 0; i < W.outerSize(); ++i) {
     const Eigen::Vector3d v = V.row(i).transpose();

@@ -26,6 +26,11 @@ namespace skinlab::geometry {
 Eigen::MatrixXd lbs(const Eigen::MatrixXd& V, const SparseWeights& W,
                     const std::vector<Eigen::Affine3d>& T);
 
+/// Throws GeometryError, prefixed by `who`, unless V is #V×3 and W is #V×#J for #J = T.size():
+/// the argument check of lbs and dqs.
+void check_skinning_inputs(const char* who, const Eigen::MatrixXd& V, const SparseWeights& W,
+                           const std::vector<Eigen::Affine3d>& T);
+
 /// Forward kinematics about the rest joint positions: joint j rotates its own subtree by
 /// `local_rotations[j]` about its rest position p_j, on top of its parent's motion,
 ///     T_j = T_parent(j) · Translate(p_j) · R_j · Translate(−p_j),   T_root's parent = identity.

@@ -26,12 +26,16 @@ void PrintTo(const EdgeConvCase& c, std::ostream* os) {
 
 class EdgeConvVsNaive : public ::testing::TestWithParam<EdgeConvCase> {};
 
+std::shared_ptr<GraphOp> make_case_op(const EdgeConvCase& c, const Dims& dims) {
+  return make_op("{type: edge_conv, edges: " + c.set + ", mlp: " + c.mlp +
+                     ", self_loops: " + (c.self_loops ? "true" : "false") + "}",
+                 dims);
+}
+
 TEST_P(EdgeConvVsNaive, MatchesLoopReference) {
   const auto& c = GetParam();
   const TinyGraph t = tiny_graph(3, 2);
-  auto op = make_op("{type: edge_conv, edges: " + c.set + ", mlp: " + c.mlp +
-                        ", self_loops: " + (c.self_loops ? "true" : "false") + "}",
-                    t.dims);
+  auto op = make_case_op(c, t.dims);
   const Features out = op->forward(t.features, t.graph);
   const bool bones = c.set == "skeleton";
   const torch::Tensor& x = bones ? t.features.bone : t.features.vertex;
@@ -59,9 +63,7 @@ TEST_P(EdgeConvVsNaive, MatchesLoopReference) {
 TEST_P(EdgeConvVsNaive, GradientsMatchFiniteDifferences) {
   const auto& c = GetParam();
   const TinyGraph t = tiny_graph(3, 2);
-  auto op = make_op("{type: edge_conv, edges: " + c.set + ", mlp: " + c.mlp +
-                        ", self_loops: " + (c.self_loops ? "true" : "false") + "}",
-                    t.dims);
+  auto op = make_case_op(c, t.dims);
   expect_gradients_match(*op, t.features, t.graph);
 }
 
@@ -70,9 +72,7 @@ TEST_P(EdgeConvVsNaive, WithoutGradientsTheSameValues) {
   // gather-min kernel (gather_segment_min): a min is exact, so the values are equal, not close.
   const auto& c = GetParam();
   const TinyGraph t = tiny_graph(3, 2);
-  auto op = make_op("{type: edge_conv, edges: " + c.set + ", mlp: " + c.mlp +
-                        ", self_loops: " + (c.self_loops ? "true" : "false") + "}",
-                    t.dims);
+  auto op = make_case_op(c, t.dims);
   const Features trained = op->forward(t.features, t.graph);
   ASSERT_TRUE((c.set == "skeleton" ? trained.bone : trained.vertex).requires_grad());
   torch::NoGradGuard no_grad;
