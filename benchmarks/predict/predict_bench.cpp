@@ -40,6 +40,7 @@
 
 #include "benchmarks/synthetic_body.hpp"
 #include "framework/core/environment.hpp"
+#include "framework/core/timing.hpp"
 #include "framework/geometry/gltf_export.hpp"
 #include "framework/geometry/load_character.hpp"
 #include "framework/geometry/obj_io.hpp"
@@ -113,10 +114,6 @@ struct BodyFiles {
   BodyFiles(const BodyFiles&) = delete;
   BodyFiles& operator=(const BodyFiles&) = delete;
 };
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 /// Runs a shell command, failing the benchmark if it does not exit with 0.
 bool run(benchmark::State& state, const std::string& command) {

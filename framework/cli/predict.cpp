@@ -23,10 +23,13 @@
 
 #include <chrono>
 #include <iostream>
+#include <map>
+#include <string>
 
 #include "framework/cli/commands.hpp"
 #include "framework/core/environment.hpp"
 #include "framework/core/error.hpp"
+#include "framework/core/timing.hpp"
 #include "framework/data/h5.hpp"
 #include "framework/eval/predictions.hpp"
 #include "framework/geometry/gltf_export.hpp"
@@ -40,6 +43,14 @@
 namespace skinlab::cli {
 
 namespace {
+
+/// One line: the header, then " name value" per metric with 4 decimals (scripts/compare_blender
+/// reads these lines).
+void print_metrics(const std::string& header, const std::map<std::string, double>& values) {
+  std::cout << header;
+  for (const auto& [name, value] : values) std::cout << fmt::format(" {} {:.4f}", name, value);
+  std::cout << "\n";
+}
 
 namespace fs = std::filesystem;
 
@@ -121,7 +132,7 @@ int run(const PredictArgs& args) {
     throw Error((args.rig.empty() ? args.input : args.input + " with " + args.rig) + ": " +
                 e.what());
   }
-  times.load = std::chrono::duration<double>(Clock::now() - start).count();
+  times.load = seconds_since(start);
   if ((args.compare || args.error_map) && !input.has_weights()) {
     throw Error(args.input + ": " + (args.compare ? "--compare-to-input" : "--error-map") +
                 ", but the input carries no skin weights");
@@ -130,15 +141,12 @@ int run(const PredictArgs& args) {
   const fs::path model_dir = args.model.empty() ? default_model() : fs::path(args.model);
   start = Clock::now();
   const predict::Predictor predictor = predict::Predictor::load(model_dir, args.checkpoint);
-  const double model_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  const double model_seconds = seconds_since(start);
   spdlog::info("model: {}", predictor.description());
   const predict::Prediction p = predictor.predict(input, options, &times);
 
   if (args.compare) {
-    const auto values = predictor.compare(p);
-    std::cout << fmt::format("{} against the input's weights:", input.name);
-    for (const auto& [name, value] : values) std::cout << fmt::format(" {} {:.4f}", name, value);
-    std::cout << "\n";
+    print_metrics(input.name + " against the input's weights:", predictor.compare(p));
   }
 
   start = Clock::now();
@@ -167,7 +175,7 @@ int run(const PredictArgs& args) {
     }
     std::cout << "wrote " << out << "\n";
   }
-  times.export_ = std::chrono::duration<double>(Clock::now() - start).count();
+  times.export_ = seconds_since(start);
   if (!args.render.empty()) {
     // In the normalised frame (Y up), at the prepared vertices, where the weights were made.
     const Eigen::MatrixXd truth =
@@ -285,10 +293,7 @@ int run_score(const std::string& input, const std::string& rig, const std::strin
   }
   const fs::path model_dir = model.empty() ? default_model() : fs::path(model);
   const predict::Predictor predictor = predict::Predictor::load(model_dir);
-  const auto values = predictor.score(truth, mapped);
-  std::cout << fmt::format("{} against the weights of {}:", weights, input);
-  for (const auto& [name, value] : values) std::cout << fmt::format(" {} {:.4f}", name, value);
-  std::cout << "\n";
+  print_metrics(weights + " against the weights of " + input + ":", predictor.score(truth, mapped));
   return 0;
 }
 

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "framework/core/registry.hpp"
+#include "framework/core/timing.hpp"
 #include "framework/geometry/closest_point_on_segment.hpp"
 
 namespace skinlab::distances {
@@ -138,10 +139,6 @@ void dijkstra(const SurfaceGraph& g, std::vector<double>& label,
       }
     }
   }
-}
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 }  // namespace

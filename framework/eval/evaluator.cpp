@@ -111,18 +111,16 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
   const train::RunOptions o = train::RunOptions::from(config);
   // A binder run has no checkpoint and no training loss: its weights come from the geometry.
   const bool is_binder = o.binder.exists();
+  fs::path checkpoint;
   if (is_binder) {
     o.require_binder_sections(config);
   } else {
-    if (options.checkpoint != "best" && options.checkpoint != "last") {
-      throw Error("unknown checkpoint '" + options.checkpoint + "'; choose best or last");
-    }
+    checkpoint = train::checkpoint_file(run.path(), options.checkpoint);
     o.require_training_sections(config);
-  }
-  const fs::path checkpoint = run.file(options.checkpoint + ".pt");
-  if (!is_binder && !fs::exists(checkpoint)) {
-    throw IoError(checkpoint.string() + ": no checkpoint '" + options.checkpoint +
-                  "' in this run (a run writes best.pt and last.pt after its first epoch)");
+    if (!fs::exists(checkpoint)) {
+      throw IoError(checkpoint.string() + ": no checkpoint '" + options.checkpoint +
+                    "' in this run (a run writes best.pt and last.pt after its first epoch)");
+    }
   }
 
   train::RunData data(o.data);

@@ -4,13 +4,13 @@
 #include <torch/torch.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 #include "datasets/source.hpp"
 #include "framework/core/atomic_file.hpp"
 #include "framework/core/config.hpp"
 #include "framework/core/error.hpp"
+#include "framework/core/timing.hpp"
 #include "framework/core/registry.hpp"
 #include "framework/data/h5.hpp"
 #include "framework/data/tensors.hpp"
@@ -25,15 +25,7 @@ namespace skinlab::predict {
 
 namespace fs = std::filesystem;
 
-namespace {
-
 using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-}  // namespace
 
 void check_predictable(const geometry::Character& c, const PredictOptions& options) {
   const int nv = c.mesh.num_vertices();
@@ -111,10 +103,7 @@ Predictor Predictor::load(const fs::path& dir, const std::string& checkpoint) {
   if (fs::exists(bundled)) {
     weights = bundled;
   } else {
-    if (checkpoint != "best" && checkpoint != "last") {
-      throw Error("unknown checkpoint '" + checkpoint + "'; choose best or last");
-    }
-    weights = dir / (checkpoint + ".pt");
+    weights = train::checkpoint_file(dir, checkpoint);
     if (!fs::exists(weights)) {
       throw IoError(weights.string() + ": no checkpoint (checkpoints stay out of git; train the "
                     "run again or use the bundled model)");
@@ -261,11 +250,8 @@ std::map<std::string, double> Predictor::score(const geometry::Character& truth,
 
 void bundle(const fs::path& run_dir, const fs::path& out, const std::string& checkpoint) {
   if (fs::exists(out)) throw IoError(out.string() + ": exists; remove it or choose another --out");
-  if (checkpoint != "best" && checkpoint != "last") {
-    throw Error("unknown checkpoint '" + checkpoint + "'; choose best or last");
-  }
   const fs::path config_file = run_dir / "config.yaml";
-  const fs::path weights = run_dir / (checkpoint + ".pt");
+  const fs::path weights = train::checkpoint_file(run_dir, checkpoint);
   for (const fs::path& f : {config_file, weights}) {
     if (!fs::exists(f)) throw IoError(f.string() + ": missing; bundle needs a trained run");
   }

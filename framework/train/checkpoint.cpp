@@ -13,6 +13,14 @@
 
 namespace skinlab::train {
 
+std::filesystem::path checkpoint_file(const std::filesystem::path& run_dir,
+                                      const std::string& which) {
+  if (which != "best" && which != "last") {
+    throw Error("unknown checkpoint '" + which + "'; choose best or last");
+  }
+  return run_dir / (which + ".pt");
+}
+
 namespace fs = std::filesystem;
 
 namespace {

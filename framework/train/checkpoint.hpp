@@ -43,6 +43,11 @@ std::string parameter_spec(const torch::nn::Module& model);
 /// checkpoint would be written but could never be read back. The Trainer checks this up front.
 void check_checkpointable(const torch::nn::Module& model);
 
+/// `run_dir`/best.pt or `run_dir`/last.pt for `which` = "best" or "last" (whether it exists is
+/// the caller's question). Throws Error for any other name.
+std::filesystem::path checkpoint_file(const std::filesystem::path& run_dir,
+                                      const std::string& which);
+
 /// Writes `path` atomically. `optimizer` may be null (then no optimizer state is stored).
 void save_checkpoint(const std::filesystem::path& path, const torch::nn::Module& model,
                      const torch::optim::Optimizer* optimizer, const TrainingState& state);
