@@ -29,6 +29,7 @@ CleaningOptions CleaningOptions::from(const config::Node& node) {
     if (!exclude.is_map()) exclude.fail("expected a map of character name → reason");
     for (const auto& name : exclude.keys()) o.exclude[name] = exclude[name].as<std::string>();
   }
+  f.optional("skeletons", o.skeletons);
   f.check(o.min_bones >= 0, "min_bones", "must be ≥ 0");
   f.check(o.quantum > 0, "quantum", "must be positive");
   f.check(o.group_cell > 0, "group_cell", "must be positive");
@@ -210,6 +211,12 @@ std::vector<CleanedCharacter> clean(std::vector<datasets::SourceCharacter> chara
     };
     if (auto it = options.exclude.find(c.character.name); it != options.exclude.end()) {
       drop("excluded by the config: " + it->second);
+      continue;
+    }
+    if (!options.skeletons.empty() &&
+        std::find(options.skeletons.begin(), options.skeletons.end(), c.skeleton) ==
+            options.skeletons.end()) {
+      drop("skeleton family '" + c.skeleton + "' is not in cleaning.skeletons");
       continue;
     }
     if (!c.character.has_weights()) {

@@ -9,6 +9,9 @@
 ///    a cart or a UI marker that pass the rules below but are not characters) is dropped with
 ///    that reason, and a character without weights is dropped ("no skin weights"). A name in
 ///    `exclude` that no source gives is an error (a typo would otherwise keep the prop).
+///    When `skeletons` lists skeleton families, a character of any other family is dropped
+///    ("skeleton family X is not in cleaning.skeletons"): a task that needs one shared skeleton,
+///    such as DenseGATs' corrective deformation on the 0 A.D. bipeds, prepares only those.
 /// 1. **Too few bones**: a character whose weights put a positive weight on fewer than
 ///    `min_bones` joints is dropped (RigNet's data filter keeps rigs with enough skinned joints;
 ///    a skinning network has nothing to learn on a 2-bone prop).
@@ -54,6 +57,7 @@ struct CleaningOptions {
   double group_cell = 1.0 / 128;   ///< metres: cell of the surface-occupancy comparison
   double group_similarity = 0.99;  ///< surface overlap (rule 4) for one group; > 1: off
   std::map<std::string, std::string> exclude;  ///< character name → reason (rule 0)
+  std::vector<std::string> skeletons;  ///< keep only these skeleton families; empty: all (rule 0)
 
   /// Decodes a `cleaning:` map (every field optional); errors name the file, line and key.
   static CleaningOptions from(const config::Node& node);

@@ -109,6 +109,20 @@ TEST(Clean, ConfigExclusionsCarryTheirReasonAndMustNameACharacter) {
   EXPECT_THROW(clean({sheet("person", 8, 1.0)}, options, excluded), Error);
 }
 
+TEST(Clean, ASkeletonListKeepsOnlyThoseFamilies) {
+  const auto options =
+      CleaningOptions::from(config::Config::parse("skeletons: [Biped]").root());
+  datasets::SourceCharacter human = sheet("human", 8, 0.0), horse = sheet("horse", 8, 1.0);
+  human.skeleton = "Biped";
+  horse.skeleton = "Horse";
+  std::vector<datasets::Excluded> excluded;
+  auto kept = clean({horse, human}, options, excluded);
+  ASSERT_EQ(kept.size(), 1u);
+  EXPECT_EQ(kept[0].source.character.name, "human");
+  ASSERT_EQ(excluded.size(), 1u);
+  EXPECT_EQ(excluded[0].reason, "horse: skeleton family 'Horse' is not in cleaning.skeletons");
+}
+
 TEST(Clean, DuplicateHashIgnoresUnitsPlacementAndOrder) {
   const auto a = sheet("a", 6, 0.4);
   const auto b = reordered_copy(a, "b");
