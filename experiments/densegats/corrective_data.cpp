@@ -1,0 +1,240 @@
+#include "experiments/densegats/corrective_data.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <map>
+
+#include "framework/core/error.hpp"
+#include "framework/geometry/lbs.hpp"
+#include "framework/geometry/orient_outward.hpp"
+#include "framework/geometry/vertex_normals.hpp"
+
+namespace skinlab::densegats {
+
+namespace {
+
+/// 12 floats [R | t] row-major → a rigid transform; the rotation is re-orthonormalised (float32
+/// storage leaves it orthogonal to ~1e-7 only, and dual quaternion skinning checks rigidity).
+Eigen::Isometry3d rigid_from(const float* m) {
+  Eigen::Matrix3d r;
+  Eigen::Vector3d t;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) r(i, j) = m[4 * i + j];
+    t(i) = m[4 * i + 3];
+  }
+  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  out.linear() = Eigen::Quaterniond(r).normalized().toRotationMatrix();
+  out.translation() = t;
+  return out;
+}
+
+/// N⁻¹ · T · N for a similarity N (undoes the normalisation) as a rigid transform.
+Eigen::Isometry3d conjugate(const Eigen::Matrix4d& N, const Eigen::Matrix4d& N_inverse,
+                            const Eigen::Isometry3d& T) {
+  const Eigen::Matrix4d m = N_inverse * T.matrix() * N;
+  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  out.linear() = Eigen::Quaterniond(Eigen::Matrix3d(m.topLeftCorner<3, 3>())).normalized().toRotationMatrix();
+  out.translation() = m.topRightCorner<3, 1>();
+  return out;
+}
+
+torch::Tensor edge_tensor(const data::RowMatrixXi& edges) {
+  torch::Tensor t = torch::empty({edges.rows(), 2}, torch::kInt64);
+  auto a = t.accessor<std::int64_t, 2>();
+  for (Eigen::Index e = 0; e < edges.rows(); ++e) {
+    a[e][0] = edges(e, 0);
+    a[e][1] = edges(e, 1);
+  }
+  return t;
+}
+
+}  // namespace
+
+CorrectiveOptions CorrectiveOptions::from(const config::Node& node) {
+  CorrectiveOptions o;
+  config::Fields f(node, "corrective", {});
+  f.optional("skeleton", o.skeleton);
+  f.optional("frame_stride", o.frame_stride);
+  f.optional("max_poses_per_character", o.max_poses_per_character);
+  f.optional("height_m", o.height_m);
+  const config::Node mush = f.section("delta_mush");
+  if (mush.exists() && !mush.is_null()) {
+    config::Fields m(mush, "corrective.delta_mush", {});
+    m.optional("iterations", o.delta_mush.iterations);
+    m.optional("step", o.delta_mush.step);
+    m.check(o.delta_mush.iterations >= 1, "iterations", "must be ≥ 1");
+    m.check(o.delta_mush.step > 0 && o.delta_mush.step <= 1, "step", "must be in (0, 1]");
+    m.finish();
+  }
+  f.check(!o.skeleton.empty(), "skeleton", "must name a skeleton family");
+  f.check(o.frame_stride >= 1, "frame_stride", "must be ≥ 1");
+  f.check(o.max_poses_per_character >= 0, "max_poses_per_character", "must be ≥ 0 (0: all)");
+  f.check(o.height_m > 0, "height_m", "must be positive");
+  f.finish();
+  return o;
+}
+
+CorrectiveData::CorrectiveData(const data::Dataset& dataset, const std::string& file,
+                               const CorrectiveOptions& options)
+    : options_(options), file_(file) {
+  // The family, its joint layout, and the pooled clips (one per name, in file order).
+  const data::PreparedCharacter* first = nullptr;
+  std::map<std::string, int> clip_index;
+  for (std::size_t i = 0; i < dataset.characters.size(); ++i) {
+    const data::PreparedCharacter& c = dataset.characters[i];
+    if (c.skeleton != options.skeleton) continue;
+    if (first == nullptr) {
+      first = &c;
+      num_joints_ = c.num_joints();
+    } else if (c.joint_names != first->joint_names) {
+      throw IoError(fmt::format("{}: characters '{}' and '{}' of skeleton family '{}' have "
+                                "different joints ({} and {}); the corrective task needs one "
+                                "shared skeleton",
+                                file, first->name, c.name, options.skeleton, first->num_joints(),
+                                c.num_joints()));
+    }
+    const Eigen::Matrix4d N = c.normalisation, N_inverse = c.normalisation.inverse();
+    for (const data::AnimationData& a : c.animations) {
+      if (clip_index.count(a.name)) continue;
+      if (a.frames.size() != static_cast<std::size_t>(a.num_frames) * num_joints_ * 12) {
+        throw IoError(fmt::format("{}: clip '{}' of character '{}' does not have {} joints",
+                                  file, a.name, c.name, num_joints_));
+      }
+      PooledClip clip{a.name, c.name, {}};
+      for (int f = 0; f < a.num_frames; ++f) {
+        std::vector<Eigen::Isometry3d> frame;
+        frame.reserve(static_cast<std::size_t>(num_joints_));
+        for (int j = 0; j < num_joints_; ++j) {
+          const float* m = a.frames.data() + (static_cast<std::size_t>(f) * num_joints_ + j) * 12;
+          frame.push_back(conjugate(N, N_inverse, rigid_from(m)));
+        }
+        clip.frames.push_back(std::move(frame));
+      }
+      clip_index[a.name] = static_cast<int>(clips_.size());
+      clips_.push_back(std::move(clip));
+    }
+  }
+  if (first == nullptr) {
+    throw IoError(fmt::format("{}: no character of skeleton family '{}' (corrective.skeleton)",
+                              file, options.skeleton));
+  }
+
+  // The pose list every character shares.
+  std::vector<PoseRef> poses;
+  for (std::size_t k = 0; k < clips_.size(); ++k) {
+    for (std::size_t f = 0; f < clips_[k].frames.size();
+         f += static_cast<std::size_t>(options.frame_stride)) {
+      poses.push_back({static_cast<int>(k), static_cast<int>(f)});
+    }
+  }
+  if (options.max_poses_per_character > 0 &&
+      poses.size() > static_cast<std::size_t>(options.max_poses_per_character)) {
+    std::vector<PoseRef> kept;
+    const std::size_t n = static_cast<std::size_t>(options.max_poses_per_character);
+    for (std::size_t k = 0; k < n; ++k) kept.push_back(poses[k * poses.size() / n]);
+    poses = std::move(kept);
+  }
+
+  for (std::size_t i = 0; i < dataset.characters.size(); ++i) {
+    const data::PreparedCharacter& c = dataset.characters[i];
+    if (c.skeleton != options.skeleton) continue;
+    if (c.animations.empty()) {
+      excluded_.push_back(c.name + ": no clip of its own, so no bind pose to pose it with");
+      spdlog::info("corrective: left out {} ({})", c.name, excluded_.back());
+      continue;
+    }
+    CorrectiveCharacter out;
+    out.name = c.name;
+    out.dataset_index = static_cast<int>(i);
+    geometry::Mesh mesh{c.V, c.F};
+    out.mesh = geometry::orient_outward(mesh);
+    out.weights = c.weights;
+    out.joints = c.joints;
+    out.normalisation = c.normalisation;
+    out.root = static_cast<int>(std::find(c.parents.begin(), c.parents.end(), -1) - c.parents.begin());
+    const data::AnimationData& own = c.animations.front();
+    for (int j = 0; j < num_joints_; ++j) {
+      out.bind_inverse.push_back(rigid_from(own.bind.data() + static_cast<std::size_t>(j) * 12).inverse());
+    }
+    out.mush = std::make_shared<const geometry::DeltaMush>(out.mesh, options.delta_mush, c.name);
+    out.one_ring = edge_tensor(c.one_ring_edges);
+    out.poses = poses;
+    characters_.push_back(std::move(out));
+  }
+  if (characters_.empty()) {
+    throw IoError(fmt::format("{}: no character of skeleton family '{}' has a clip of its own to "
+                              "take its bind pose from",
+                              file, options.skeleton));
+  }
+}
+
+std::vector<int> CorrectiveData::members(const std::vector<int>& dataset_indices) const {
+  std::vector<int> out;
+  for (int index : dataset_indices) {
+    for (std::size_t k = 0; k < characters_.size(); ++k) {
+      if (characters_[k].dataset_index == index) out.push_back(static_cast<int>(k));
+    }
+  }
+  return out;
+}
+
+std::vector<Eigen::Affine3d> CorrectiveData::transforms(int character, int pose) const {
+  const CorrectiveCharacter& c = characters_.at(static_cast<std::size_t>(character));
+  const PoseRef& p = c.poses.at(static_cast<std::size_t>(pose));
+  const auto& frame = clips_[static_cast<std::size_t>(p.clip)].frames[static_cast<std::size_t>(p.frame)];
+  const Eigen::Matrix4d N = c.normalisation, N_inverse = c.normalisation.inverse();
+  std::vector<Eigen::Isometry3d> pose_transforms;
+  pose_transforms.reserve(frame.size());
+  for (std::size_t j = 0; j < frame.size(); ++j) {
+    // conjugate(N⁻¹, N, ·) = N · F · N⁻¹: the game frame into this character's normalised frame.
+    pose_transforms.push_back(conjugate(N_inverse, N, frame[j]) * c.bind_inverse[j]);
+  }
+  const Eigen::Isometry3d to_root = pose_transforms[static_cast<std::size_t>(c.root)].inverse();
+  std::vector<Eigen::Affine3d> out;
+  out.reserve(frame.size());
+  for (const auto& t : pose_transforms) out.emplace_back((to_root * t).matrix());
+  return out;
+}
+
+torch::Tensor CorrectiveData::features(int character, const Eigen::MatrixXd& posed,
+                                       const std::vector<Eigen::Affine3d>& transforms) const {
+  const CorrectiveCharacter& c = characters_.at(static_cast<std::size_t>(character));
+  const Eigen::MatrixXd normals = geometry::vertex_normals(geometry::Mesh{posed, c.mesh.F});
+  Eigen::MatrixXd joints(c.num_joints(), 3);
+  for (int j = 0; j < c.num_joints(); ++j) {
+    joints.row(j) = (transforms[static_cast<std::size_t>(j)] * Eigen::Vector3d(c.joints.row(j).transpose())).transpose();
+  }
+  const std::int64_t n = posed.rows(), width = 6 + c.num_joints();
+  torch::Tensor out = torch::empty({n, width}, torch::kFloat32);
+  auto a = out.accessor<float, 2>();
+  for (std::int64_t i = 0; i < n; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      a[i][k] = static_cast<float>(posed(i, k));
+      a[i][3 + k] = static_cast<float>(normals(i, k));
+    }
+    for (int j = 0; j < c.num_joints(); ++j) {
+      a[i][6 + j] = static_cast<float>((posed.row(i) - joints.row(j)).norm());
+    }
+  }
+  return out;
+}
+
+CorrectiveSample CorrectiveData::sample(int character, int pose) const {
+  const CorrectiveCharacter& c = characters_.at(static_cast<std::size_t>(character));
+  const std::vector<Eigen::Affine3d> T = transforms(character, pose);
+  CorrectiveSample s;
+  s.lbs = geometry::lbs(c.mesh.V, c.weights, T);
+  s.target = c.mush->deform(s.lbs, &s.passthrough);
+  s.displacement = (s.target - s.lbs) * cm_per_unit();
+  s.features = features(character, s.lbs, T);
+  s.displacement_t = torch::empty({s.lbs.rows(), 3}, torch::kFloat32);
+  auto a = s.displacement_t.accessor<float, 2>();
+  for (Eigen::Index i = 0; i < s.lbs.rows(); ++i) {
+    for (int k = 0; k < 3; ++k) a[i][k] = static_cast<float>(s.displacement(i, k));
+  }
+  return s;
+}
+
+}  // namespace skinlab::densegats

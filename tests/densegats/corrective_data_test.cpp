@@ -1,0 +1,201 @@
+// DenseGATs' corrective-deformation data on the bundled real 0 A.D. bipeds (f_dress,
+// m_armor_pants, m_tunic_short with their own game clips): the pose rule reproduces the
+// engine's skinning of a character's own clip, the root stays at its bind pose, clips carry over
+// between characters of the family, the features are [p, n, s] of the LBS mesh, the target is
+// Delta Mush's correction, and bad data is an error naming the file and the character.
+#include "experiments/densegats/corrective_data.hpp"
+
+#include <gtest/gtest.h>
+
+#include <set>
+
+#include "framework/core/error.hpp"
+#include "framework/data/prepare.hpp"
+#include "framework/geometry/lbs.hpp"
+#include "tests/test_util.hpp"
+
+namespace skinlab::densegats {
+namespace {
+
+using skinlab::testing::expect_error;
+
+/// The bundled bipeds, prepared once for the whole suite.
+class CorrectiveDataTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new skinlab::testing::TempDir();
+    file_ = (*dir_ / "bipeds.h5").string();
+    const std::string source = std::string(SKINLAB_SOURCE_DIR);
+    data::PrepareOptions quiet;
+    quiet.threads = 2;
+    quiet.progress = false;
+    data::prepare_dataset(
+        data::PrepareConfig::from(config::Config::load(
+            source + "/configs/datasets/zeroad_bipeds_bundled.yaml",
+            {"output=" + file_,
+             "sources=[{type: zeroad, path: " + source + "/datasets/zeroad/bundled}]"})),
+        quiet);
+    dataset_ = new data::Dataset(data::read_dataset(file_));
+  }
+  static void TearDownTestSuite() {
+    delete dataset_;
+    delete dir_;
+  }
+  static CorrectiveOptions options(int stride = 8) {
+    CorrectiveOptions o;
+    o.frame_stride = stride;
+    return o;
+  }
+  static inline skinlab::testing::TempDir* dir_ = nullptr;
+  static inline std::string file_;
+  static inline data::Dataset* dataset_ = nullptr;
+};
+
+TEST_F(CorrectiveDataTest, TheBundledBipedsShareTheirElevenClips) {
+  const CorrectiveData data(*dataset_, file_, options());
+  ASSERT_EQ(data.characters().size(), 3u);
+  EXPECT_TRUE(data.excluded().empty());
+  EXPECT_EQ(data.num_joints(), 46);
+  EXPECT_EQ(data.feature_width(), 52);
+  std::set<std::string> names;
+  for (const auto& clip : data.clips()) names.insert(clip.name);
+  EXPECT_EQ(names.size(), data.clips().size());  // one copy per clip name
+  EXPECT_GE(data.clips().size(), 8u);
+  // Every character gets every pose of the pool.
+  for (const auto& c : data.characters()) EXPECT_EQ(c.poses.size(), data.characters()[0].poses.size());
+  // The split has one garment per part.
+  const data::Split& split = dataset_->splits.at("random");
+  EXPECT_EQ(data.members(split.train).size() + data.members(split.val).size() +
+                data.members(split.test).size(),
+            3u);
+}
+
+TEST_F(CorrectiveDataTest, OwnClipsFollowTheEngineRuleAndTheRootStaysAtItsBindPose) {
+  const CorrectiveData data(*dataset_, file_, options());
+  for (int c = 0; c < static_cast<int>(data.characters().size()); ++c) {
+    const CorrectiveCharacter& ch = data.characters()[static_cast<std::size_t>(c)];
+    const data::PreparedCharacter& prepared = dataset_->characters[static_cast<std::size_t>(ch.dataset_index)];
+    const data::AnimationData& own = prepared.animations.front();
+    // Find a pose of this character's own first clip and recompute the engine's
+    // frame(j) · bind(j)⁻¹ from the stored floats, relative to the root.
+    int pose = -1;
+    for (std::size_t p = 0; p < ch.poses.size(); ++p) {
+      if (data.clips()[static_cast<std::size_t>(ch.poses[p].clip)].name == own.name) {
+        pose = static_cast<int>(p);
+        break;
+      }
+    }
+    ASSERT_GE(pose, 0) << ch.name;
+    const int frame = ch.poses[static_cast<std::size_t>(pose)].frame;
+    auto matrix = [](const float* m) {
+      Eigen::Matrix4d out = Eigen::Matrix4d::Identity();
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 4; ++j) out(i, j) = m[4 * i + j];
+      return out;
+    };
+    const auto T = data.transforms(c, pose);
+    const auto engine = [&](int j) {
+      return Eigen::Matrix4d(
+          matrix(own.frames.data() + (static_cast<std::size_t>(frame) * 46 + j) * 12) *
+          matrix(own.bind.data() + static_cast<std::size_t>(j) * 12).inverse());
+    };
+    const Eigen::Matrix4d root_inverse = engine(ch.root).inverse();
+    for (int j = 0; j < 46; ++j) {
+      EXPECT_TRUE(T[static_cast<std::size_t>(j)].matrix().isApprox(root_inverse * engine(j), 1e-4))
+          << ch.name << " joint " << j;
+    }
+    EXPECT_TRUE(T[static_cast<std::size_t>(ch.root)].matrix().isIdentity(1e-9)) << ch.name;
+  }
+}
+
+TEST_F(CorrectiveDataTest, SamplesAreTheLbsMeshItsFeaturesAndDeltaMushsCorrection) {
+  const CorrectiveData data(*dataset_, file_, options());
+  for (int c = 0; c < static_cast<int>(data.characters().size()); ++c) {
+    const CorrectiveCharacter& ch = data.characters()[static_cast<std::size_t>(c)];
+    // A pose of a clip owned by another character: clips carry over within the family.
+    int pose = -1;
+    for (std::size_t p = 0; p < ch.poses.size() && pose < 0; ++p) {
+      if (data.clips()[static_cast<std::size_t>(ch.poses[p].clip)].owner != ch.name) pose = static_cast<int>(p);
+    }
+    ASSERT_GE(pose, 0) << ch.name;
+    const CorrectiveSample s = data.sample(c, pose);
+    const auto T = data.transforms(c, pose);
+    EXPECT_TRUE(s.lbs.isApprox(geometry::lbs(ch.mesh.V, ch.weights, T), 1e-12));
+    EXPECT_TRUE(s.target.isApprox(ch.mush->deform(s.lbs), 1e-12));
+    EXPECT_TRUE(s.displacement.isApprox((s.target - s.lbs) * 175.0, 1e-12));
+    // Posed, not the rest mesh; the correction is real but small next to a 1.75 m body.
+    EXPECT_GT((s.lbs - ch.mesh.V).rowwise().norm().maxCoeff(), 0.02) << ch.name;
+    const double mean_cm = s.displacement.rowwise().norm().mean();
+    EXPECT_GT(mean_cm, 0.01) << ch.name;
+    EXPECT_LT(s.displacement.rowwise().norm().maxCoeff(), 20.0) << ch.name;
+    // Only vertices without a rest frame (m_tunic_short: 96 on faces whose normals cancel) keep
+    // their LBS position.
+    EXPECT_EQ(s.passthrough, ch.mush->passthrough()) << ch.name;
+    EXPECT_LT(s.passthrough, ch.num_vertices() / 10) << ch.name;
+
+    ASSERT_EQ(s.features.sizes(), (std::vector<std::int64_t>{ch.num_vertices(), 52}));
+    EXPECT_TRUE(torch::isfinite(s.features).all().item<bool>());
+    const int v = ch.num_vertices() / 2, j = 7;
+    const auto f = s.features.accessor<float, 2>();
+    EXPECT_NEAR(f[v][0], s.lbs(v, 0), 1e-6);
+    const Eigen::Vector3d joint = T[j] * Eigen::Vector3d(ch.joints.row(j).transpose());
+    EXPECT_NEAR(f[v][6 + j], (s.lbs.row(v).transpose() - joint).norm(), 1e-5);
+    const double normal = std::sqrt(f[v][3] * f[v][3] + f[v][4] * f[v][4] + f[v][5] * f[v][5]);
+    EXPECT_NEAR(normal, 1.0, 1e-5);
+    ASSERT_EQ(s.displacement_t.sizes(), (std::vector<std::int64_t>{ch.num_vertices(), 3}));
+  }
+}
+
+TEST_F(CorrectiveDataTest, PosesAreStridedAndCapped) {
+  const CorrectiveData all(*dataset_, file_, options(1)), strided(*dataset_, file_, options(4));
+  std::size_t frames = 0, expected_strided = 0;
+  for (const auto& clip : all.clips()) {
+    frames += clip.frames.size();
+    expected_strided += (clip.frames.size() + 3) / 4;
+  }
+  EXPECT_EQ(all.characters()[0].poses.size(), frames);
+  EXPECT_EQ(strided.characters()[0].poses.size(), expected_strided);
+  CorrectiveOptions capped = options(1);
+  capped.max_poses_per_character = 10;
+  EXPECT_EQ(CorrectiveData(*dataset_, file_, capped).characters()[0].poses.size(), 10u);
+}
+
+TEST_F(CorrectiveDataTest, CharactersWithoutAClipAreLeftOutWithTheReason) {
+  data::Dataset copy = *dataset_;
+  const std::string name = copy.characters[0].name;
+  copy.characters[0].animations.clear();
+  const CorrectiveData data(copy, file_, options());
+  EXPECT_EQ(data.characters().size(), 2u);
+  ASSERT_EQ(data.excluded().size(), 1u);
+  EXPECT_NE(data.excluded()[0].find(name + ": no clip of its own"), std::string::npos);
+
+  for (auto& c : copy.characters) c.animations.clear();
+  expect_error<IoError>([&] { CorrectiveData(copy, file_, options()); },
+                        {file_, "no character of skeleton family 'Biped' has a clip"});
+  CorrectiveOptions horse = options();
+  horse.skeleton = "Horse";
+  expect_error<IoError>([&] { CorrectiveData(*dataset_, file_, horse); },
+                        {file_, "no character of skeleton family 'Horse'"});
+}
+
+TEST_F(CorrectiveDataTest, DifferentJointsInOneFamilyAreAnError) {
+  data::Dataset copy = *dataset_;
+  copy.characters[1].joint_names[3] = "renamed";
+  expect_error<IoError>([&] { CorrectiveData(copy, file_, options()); },
+                        {file_, copy.characters[0].name, copy.characters[1].name, "different joints"});
+}
+
+TEST(CorrectiveOptions, AreValidated) {
+  const auto parse = [](const std::string& yaml) {
+    return CorrectiveOptions::from(config::Config::parse(yaml).root());
+  };
+  EXPECT_EQ(parse("{frame_stride: 2, delta_mush: {iterations: 5}}").delta_mush.iterations, 5);
+  EXPECT_THROW(parse("{frame_stride: 0}"), ConfigError);
+  EXPECT_THROW(parse("{height_m: -1}"), ConfigError);
+  EXPECT_THROW(parse("{delta_mush: {step: 2}}"), ConfigError);
+  EXPECT_THROW(parse("{delta_mush: {iteration: 2}}"), ConfigError);
+  EXPECT_THROW(parse("{skeletons: Biped}"), ConfigError);
+}
+
+}  // namespace
+}  // namespace skinlab::densegats
