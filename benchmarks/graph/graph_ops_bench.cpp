@@ -1,7 +1,8 @@
 // Forward and forward+backward of every graph op on a character-sized heterogeneous graph:
 // 5,000 vertices, 30,000 one-ring edges (6 per vertex, symmetric), 50,000 geodesic edges (10 per
 // vertex), 50 bones (parent → child joints of a random tree), K = 3, feature widths
-// 64–256 (HeterSkinNet Sec. 4.2: vertex 256, bone 128, global 512). Arguments: {width,
+// 64–256 (HeterSkinNet Sec. 4.2: vertex 256, bone 128, global 512), and DenseGATs' 72 for
+// `gat_block` (Sec. 3.4: 8 heads × 8 + 8, the block's own output width). Arguments: {width,
 // backward (0/1)}. `BM_EdgeConvPerEdgeReference` is the textbook per-edge formulation (gather,
 // concatenate, Linear on #E rows, scatter max) that `edge_conv_max` rewrites exactly.
 //
@@ -133,6 +134,12 @@ void BM_GconvPool(benchmark::State& s) {
   const auto w = std::to_string(s.range(0));
   run(s, "{type: gconv_pool, mlp: [" + w + "]}", s.range(0), kBoneWidth);
 }
+/// DenseGATs' GAT block (Sec. 3.4: 8 heads of 8, β = 0.125, tanhshrink; 72 → 72) on the
+/// one-ring edges, self-loops included. DenseGATs has 3 × 6 + 2 such blocks, whose inputs widen
+/// along a dense module (Eq. 5).
+void BM_GatBlock(benchmark::State& s) {
+  run(s, "{type: gat_block, heads: 8, hidden: 8, beta: 0.125}", s.range(0), kBoneWidth);
+}
 void BM_GlobalPool(benchmark::State& s) {
   run(s, "{type: global_pool, vertex_mlp: [512], bone_mlp: [512]}", s.range(0), kBoneWidth);
 }
@@ -192,6 +199,10 @@ SKINLAB_GRAPH_BENCH(BM_V2b);
 SKINLAB_GRAPH_BENCH(BM_B2v);
 SKINLAB_GRAPH_BENCH(BM_GconvPool);
 SKINLAB_GRAPH_BENCH(BM_GlobalPool);
+BENCHMARK(BM_GatBlock)
+    ->ArgsProduct({{72}, {0, 1}})
+    ->ArgNames({"width", "backward"})
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DropEdges)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
