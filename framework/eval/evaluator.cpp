@@ -105,6 +105,37 @@ torch::Tensor bind_weights(const binders::Binder& binder, const std::string& typ
 
 }  // namespace
 
+void write_eval_files(const RunDir& run, EvalReport& report, nlohmann::json header) {
+  nlohmann::json per_character = nlohmann::json::array();
+  for (const auto& c : report.characters) {
+    per_character.push_back({{"character", c.name},
+                             {"vertices", c.vertices},
+                             {"bones", c.bones},
+                             {"values", c.values}});
+  }
+  header["characters"] = report.characters.size();
+  header["mean"] = report.mean;
+  header["per_character"] = per_character;
+  header["seconds"] = report.seconds;
+  report.json = run.file("eval_" + report.part + ".json");
+  write_file_atomic(report.json, header.dump(2) + "\n");
+
+  const std::vector<std::string> names = columns(report.characters);
+  std::string csv = "character,vertices,bones";
+  for (const auto& name : names) csv += "," + csv_field(name);
+  csv += "\n";
+  for (const auto& c : report.characters) {
+    csv += fmt::format("{},{},{}", csv_field(c.name), c.vertices, c.bones);
+    for (const auto& name : names) {
+      const auto it = c.values.find(name);
+      csv += it == c.values.end() ? std::string(",") : fmt::format(",{}", it->second);
+    }
+    csv += "\n";
+  }
+  report.csv = run.file("eval_" + report.part + ".csv");
+  write_file_atomic(report.csv, csv);
+}
+
 EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   const config::Config config = config::Config::load(run.file("config.yaml"), options.overrides);
@@ -219,45 +250,17 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
   }
 
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  nlohmann::json per_character = nlohmann::json::array();
-  for (const auto& c : report.characters) {
-    per_character.push_back({{"character", c.name},
-                             {"vertices", c.vertices},
-                             {"bones", c.bones},
-                             {"values", c.values}});
-  }
-  const nlohmann::json out = {{"experiment", o.experiment},
-                              {"run", run.id()},
-                              {"dataset", o.data.file},
-                              {"split", o.data.split},
-                              {"part", options.part},
-                              {"distance", o.data.distance},
-                              {"method", is_binder ? "binder" : "model"},
-                              {"type", is_binder ? method_type
-                                                 : o.model["type"].as<std::string>()},
-                              {"checkpoint", report.checkpoint},
-                              {"epoch", epoch},
-                              {"characters", report.characters.size()},
-                              {"mean", report.mean},
-                              {"per_character", per_character},
-                              {"seconds", report.seconds}};
-  report.json = run.file("eval_" + options.part + ".json");
-  write_file_atomic(report.json, out.dump(2) + "\n");
-
-  const std::vector<std::string> names = columns(report.characters);
-  std::string csv = "character,vertices,bones";
-  for (const auto& name : names) csv += "," + csv_field(name);
-  csv += "\n";
-  for (const auto& c : report.characters) {
-    csv += fmt::format("{},{},{}", csv_field(c.name), c.vertices, c.bones);
-    for (const auto& name : names) {
-      const auto it = c.values.find(name);
-      csv += it == c.values.end() ? std::string(",") : fmt::format(",{}", it->second);
-    }
-    csv += "\n";
-  }
-  report.csv = run.file("eval_" + options.part + ".csv");
-  write_file_atomic(report.csv, csv);
+  write_eval_files(run, report,
+                   {{"experiment", o.experiment},
+                    {"run", run.id()},
+                    {"dataset", o.data.file},
+                    {"split", o.data.split},
+                    {"part", options.part},
+                    {"distance", o.data.distance},
+                    {"method", is_binder ? "binder" : "model"},
+                    {"type", is_binder ? method_type : o.model["type"].as<std::string>()},
+                    {"checkpoint", report.checkpoint},
+                    {"epoch", epoch}});
   return report;
 }
 

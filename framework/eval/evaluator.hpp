@@ -23,6 +23,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "framework/core/run_dir.hpp"
 
 namespace skinlab::eval {
@@ -54,6 +56,12 @@ struct EvalReport {
 /// The mean of each named value over the characters (eval::mean_over_characters: every character
 /// reports the same names, the loss and the configured metrics; NaN stays NaN).
 std::map<std::string, double> mean_values(const std::vector<CharacterResult>& characters);
+
+/// Writes `report` into `run` as eval_<part>.json (the fields of `header`, then characters,
+/// mean, per_character and seconds) and eval_<part>.csv (one row per character), each
+/// atomically, and sets report.json and report.csv. Every task's evaluation writes through it,
+/// so `skinlab table` reads them alike.
+void write_eval_files(const RunDir& run, EvalReport& report, nlohmann::json header);
 
 /// Evaluates `run` (see the file comment). Throws Error/IoError/ConfigError for: an unknown part
 /// or checkpoint name, a missing checkpoint, a checkpoint that does not match the model of the

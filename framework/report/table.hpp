@@ -5,7 +5,8 @@
 /// reads each run's `eval_<part>.json` (framework/eval/evaluator.hpp) and writes one row per run:
 /// mean ± standard deviation over the part's characters of every metric, and a one-way ANOVA
 /// (eval/anova.hpp) of the per-character values of the reference run (the first) against each
-/// other run, per metric (Sec. 4.5, Fig. 9).
+/// other run, per metric (Sec. 4.5, Fig. 9); with a single character per run there is no
+/// ANOVA (no degrees of freedom within), only the rows.
 ///
 /// Every run must have been evaluated on the same characters (same dataset, split and part);
 /// otherwise the comparison would not mean anything, and it is an error naming the run and the

@@ -130,6 +130,13 @@ void save_checkpoint(const fs::path& path, const torch::nn::Module& model,
     archive.write("rng/order", state.order_rng);
   }
 
+  std::string extra_keys;
+  for (const auto& [key, value] : state.extra) {
+    extra_keys += (extra_keys.empty() ? "" : "\n") + key;
+    archive.write("extra/" + key, c10::IValue(value));
+  }
+  archive.write("extra_keys", c10::IValue(extra_keys));
+
   AtomicPath out(path);
   try {
     archive.save_to(out.temp().string());
@@ -188,6 +195,13 @@ TrainingState load_checkpoint(const fs::path& path, torch::nn::Module& model,
     if (read("has_rng").toBool()) {
       archive.read("rng/torch", state.torch_rng);
       archive.read("rng/order", state.order_rng);
+    }
+    c10::IValue keys;
+    if (archive.try_read("extra_keys", keys)) {
+      std::istringstream lines(keys.toStringRef());
+      for (std::string key; std::getline(lines, key);) {
+        if (!key.empty()) state.extra[key] = read("extra/" + key).toDouble();
+      }
     }
   } catch (const c10::Error& e) {
     throw IoError(where + "cannot read checkpoint: " + e.what_without_backtrace());

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <string>
 
 namespace skinlab::train {
@@ -32,6 +33,9 @@ struct TrainingState {
   torch::Tensor torch_rng;       ///< state of libtorch's default CPU generator (dropout etc.)
   torch::Tensor order_rng;       ///< state of the generator of the training order
   std::string model_config;      ///< the `model:` section as YAML, for messages
+  /// A task's own scalar state (e.g. the corrective task's learning-rate plateau counter);
+  /// empty for the skinning Trainer. Absent from a checkpoint written without it.
+  std::map<std::string, double> extra;
 };
 
 /// "name [d0, d1, ...]" of every parameter and buffer of `model`, one per line, in the module's

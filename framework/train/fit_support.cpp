@@ -1,0 +1,79 @@
+#include "framework/train/fit_support.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <filesystem>
+#include <mutex>
+
+#include "framework/core/atomic_file.hpp"
+#include "framework/train/trainer.hpp"
+
+namespace skinlab::train {
+
+namespace fs = std::filesystem;
+
+torch::Tensor get_rng_state(at::Generator generator) {
+  std::lock_guard<std::mutex> lock(generator.mutex());
+  return generator.get_state();
+}
+
+void set_rng_state(at::Generator& generator, const torch::Tensor& state) {
+  std::lock_guard<std::mutex> lock(generator.mutex());
+  generator.set_state(state);
+}
+
+std::uint64_t order_seed(std::int64_t seed) {
+  return static_cast<std::uint64_t>(seed) * 0x9E3779B97F4A7C15ull + 0x6A09E667F3BCC909ull;
+}
+
+std::string duration(double seconds) {
+  const long s = std::lround(std::max(0.0, seconds));
+  return fmt::format("{}:{:02}:{:02}", s / 3600, s / 60 % 60, s % 60);
+}
+
+std::string parts_text(const std::map<std::string, double>& parts) {
+  std::string out;
+  for (const auto& [name, value] : parts) out += fmt::format("{}{} {:.5g}", out.empty() ? "" : ", ", name, value);
+  return out;
+}
+
+nlohmann::json parts_json(const std::map<std::string, double>& parts) {
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& [name, value] : parts) out[name] = value;
+  return out;
+}
+
+void remove_stale_temporaries(const RunDir& run) {
+  for (const auto& entry : fs::directory_iterator(run.path())) {
+    const std::string name = entry.path().filename().string();
+    for (const char* target : {kLastCheckpoint, kBestCheckpoint, "metrics.jsonl"}) {
+      if (name.rfind("." + std::string(target) + ".tmp-", 0) == 0) {
+        spdlog::warn("removing {} left by an interrupted write", entry.path().string());
+        fs::remove(entry.path());
+      }
+    }
+  }
+}
+
+void truncate_metrics(const RunDir& run, std::int64_t epoch) {
+  const fs::path file = run.file("metrics.jsonl");
+  if (!fs::exists(file)) return;
+  std::string kept;
+  std::size_t dropped = 0;
+  for (const auto& record : run.read_metrics()) {
+    if (record.contains("epoch") && record["epoch"].is_number_integer() &&
+        record["epoch"].get<std::int64_t>() > epoch) {
+      ++dropped;
+      continue;
+    }
+    kept += record.dump() + "\n";
+  }
+  if (dropped > 0) {
+    spdlog::info("dropping {} metrics record(s) after epoch {} (not checkpointed)", dropped, epoch);
+    write_file_atomic(file, kept);
+  }
+}
+
+}  // namespace skinlab::train

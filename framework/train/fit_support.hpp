@@ -1,0 +1,44 @@
+#pragma once
+/// \file
+/// What every training loop of the framework shares (the skinning Trainer, trainer.hpp, and the
+/// corrective-deformation task, experiments/densegats): generator state for checkpoints, the
+/// training order's own seed, progress text, and cleaning up after a killed process, so that
+/// resuming means the same thing in every task.
+
+#include <ATen/core/Generator.h>
+#include <torch/torch.h>
+
+#include <cstdint>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "framework/core/run_dir.hpp"
+
+namespace skinlab::train {
+
+/// A copy of `generator`'s state (under its lock), for a checkpoint.
+torch::Tensor get_rng_state(at::Generator generator);
+/// Restores a state from get_rng_state.
+void set_rng_state(at::Generator& generator, const torch::Tensor& state);
+
+/// Seed of the training order's generator: its own stream, so a model that draws more or fewer
+/// random numbers (dropout on or off) still sees the data in the same order.
+std::uint64_t order_seed(std::int64_t seed);
+
+/// "h:mm:ss".
+std::string duration(double seconds);
+/// "kl 0.1, laplacian_smoothing 0.02": a loss's parts for a log line.
+std::string parts_text(const std::map<std::string, double>& parts);
+/// The same as a JSON object, for metrics.jsonl.
+nlohmann::json parts_json(const std::map<std::string, double>& parts);
+
+/// Removes files a killed process left while writing `last.pt`, `best.pt` or `metrics.jsonl`
+/// (AtomicPath's `.<name>.tmp-<pid>-<n>`).
+void remove_stale_temporaries(const RunDir& run);
+
+/// Keeps the metrics.jsonl records of epochs ≤ `epoch` (a killed run may have logged an epoch
+/// whose checkpoint it never wrote; that epoch is trained again).
+void truncate_metrics(const RunDir& run, std::int64_t epoch);
+
+}  // namespace skinlab::train
