@@ -14,6 +14,10 @@ Registry<models::Model>& model_registry() {
   static Registry<models::Model> registry("model");
   return registry;
 }
+Registry<models::CorrectiveModel>& corrective_model_registry() {
+  static Registry<models::CorrectiveModel> registry("corrective_model");
+  return registry;
+}
 Registry<losses::Loss>& loss_registry() {
   static Registry<losses::Loss> registry("loss");
   return registry;
@@ -33,8 +37,9 @@ Registry<binders::Binder>& binder_registry() {
 }
 
 std::vector<const RegistryBase*> all_registries() {
-  return {&distance_registry(), &graph_op_registry(), &model_registry(), &loss_registry(),
-          &metric_registry(),   &dataset_registry(),  &binder_registry()};
+  return {&distance_registry(), &graph_op_registry(), &model_registry(),
+          &corrective_model_registry(), &loss_registry(), &metric_registry(),
+          &dataset_registry(), &binder_registry()};
 }
 
 void verify_registries() {

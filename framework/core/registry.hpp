@@ -125,7 +125,7 @@ class Registrar {
 // core does not depend on geometry or libtorch headers.
 namespace distances { class Distance; }
 namespace graph { class GraphOp; }
-namespace models { class Model; }
+namespace models { class Model; class CorrectiveModel; }
 namespace losses { class Loss; }
 namespace eval { class Metric; }
 namespace datasets { class DatasetBuilder; }
@@ -137,6 +137,9 @@ Registry<distances::Distance>& distance_registry();
 Registry<graph::GraphOp>& graph_op_registry();
 /// `model`: complete skinning networks (HeterSkinNet and the baselines).
 Registry<models::Model>& model_registry();
+/// `corrective_model`: networks predicting a per-vertex corrective displacement over linear
+/// blend skinning (DenseGATs, experiments/densegats).
+Registry<models::CorrectiveModel>& corrective_model_registry();
 /// `loss`: training losses combined by weight.
 Registry<losses::Loss>& loss_registry();
 /// `metric`: evaluation metrics.

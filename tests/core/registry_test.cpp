@@ -103,8 +103,10 @@ TEST(Registry, ExactKeysOfEveryCategory) {
   for (const auto* registry : all_registries()) actual[registry->name()] = registry->keys();
   const std::map<std::string, std::vector<std::string>> expected = {
       {"distance", {"euclidean", "hollow_dist", "volumetric_geodesic"}},
-      {"graph_op", {"b2v", "edge_conv", "gconv_pool", "global_pool", "mesh_conv", "v2b"}},
+      {"graph_op",
+       {"b2v", "edge_conv", "gat_block", "gconv_pool", "global_pool", "mesh_conv", "v2b"}},
       {"model", {"heterskinnet", "neuroskinning", "rignet_skin"}},
+      {"corrective_model", {"densegats"}},
       {"loss", {"kl", "laplacian_smoothing", "mse", "soft_cross_entropy"}},
       {"metric", {"avg_l1", "deformation_error", "precision_recall"}},
       {"dataset", {"cube2", "folder", "nexuiz", "zeroad"}},

@@ -259,9 +259,10 @@ TEST(Sequence, ConfigErrorsNameTheEntry) {
       "i:\n  - {type: v2b, variance_scale: -1}\n",
       "test.yaml");
   const auto root = config.root();
-  expect_error<RegistryError>([&] { Sequence::from(root["a"]); },
-                              {"test.yaml:3: a[1]", "unknown graph_op type 'spectral_conv'",
-                               "b2v, edge_conv, gconv_pool, global_pool, mesh_conv, v2b"});
+  expect_error<RegistryError>(
+      [&] { Sequence::from(root["a"]); },
+      {"test.yaml:3: a[1]", "unknown graph_op type 'spectral_conv'",
+       "b2v, edge_conv, gat_block, gconv_pool, global_pool, mesh_conv, v2b"});
   expect_error<ConfigError>(
       [&] { Sequence::from(root["b"]); },
       {"test.yaml:5", "unknown field of graph_op 'edge_conv'", "did you mean 'self_loops'?"});
@@ -300,6 +301,7 @@ const std::map<std::string, std::string>& op_configs() {
       {"b2v", "{type: b2v, mlp: [4, 3]}"},
       {"global_pool", "{type: global_pool, vertex_mlp: [3], bone_mlp: [2], to: [vertex, bone]}"},
       {"gconv_pool", "{type: gconv_pool, mlp: [4, 3]}"},
+      {"gat_block", "{type: gat_block, heads: 2, hidden: 2, beta: 0.5}"},
   };
   return configs;
 }
@@ -372,7 +374,8 @@ TEST_P(EveryOp, LifeCycleAndFeatureErrors) {
 }
 
 INSTANTIATE_TEST_SUITE_P(GraphOps, EveryOp,
-                         ::testing::Values("b2v", "edge_conv", "global_pool", "mesh_conv", "v2b"),
+                         ::testing::Values("b2v", "edge_conv", "gat_block", "global_pool",
+                                           "mesh_conv", "v2b"),
                          [](const auto& info) { return info.param; });
 
 }  // namespace
