@@ -68,6 +68,24 @@ CorrectiveOptions CorrectiveOptions::from(const config::Node& node) {
     m.check(o.delta_mush.step > 0 && o.delta_mush.step <= 1, "step", "must be in (0, 1]");
     m.finish();
   }
+  f.optional("samples_per_epoch", o.samples_per_epoch)
+      .check(o.samples_per_epoch >= 1, "samples_per_epoch", "must be ≥ 1");
+  f.optional("batch_size", o.batch_size).check(o.batch_size >= 1, "batch_size", "must be ≥ 1");
+  f.optional("window", o.window).check(o.window >= 0, "window", "must be ≥ 0 (0: whole mesh)");
+  f.optional("eval_poses", o.eval_poses).check(o.eval_poses >= 1, "eval_poses", "must be ≥ 1");
+  const config::Node plateau = f.section("plateau");
+  if (plateau.exists() && !plateau.is_null()) {
+    config::Fields p(plateau, "corrective.plateau", {});
+    p.optional("factor", o.plateau_factor)
+        .check(o.plateau_factor > 0 && o.plateau_factor <= 1, "factor", "must be in (0, 1]");
+    p.optional("patience", o.plateau_patience)
+        .check(o.plateau_patience >= 1, "patience", "must be ≥ 1");
+    p.optional("min_lr", o.plateau_min_lr).check(o.plateau_min_lr >= 0, "min_lr", "must be ≥ 0");
+    p.finish();
+  }
+  f.optional("baseline", o.baseline)
+      .check(o.baseline.empty() || o.baseline == "lbs" || o.baseline == "dqs", "baseline",
+             "must be lbs or dqs (or absent: a trained model)");
   f.check(!o.skeleton.empty(), "skeleton", "must name a skeleton family");
   f.check(o.frame_stride >= 1, "frame_stride", "must be ≥ 1");
   f.check(o.max_poses_per_character >= 0, "max_poses_per_character", "must be ≥ 0 (0: all)");

@@ -58,12 +58,27 @@ namespace skinlab::densegats {
 ///       max_poses_per_character: 0   # 0 = all; else that many, evenly spaced over the list
 ///       height_m: 1.75           # cm at this height
 ///       delta_mush: {iterations: 10, step: 0.5}
+///       # training and evaluation (corrective_task.hpp; Sec. 3.4 and 4)
+///       samples_per_epoch: 400   # (character, pose) samples drawn per epoch
+///       batch_size: 8            # samples per optimizer step (Sec. 3.4: 8)
+///       window: 1000             # consecutive vertices per training sample (Sec. 4: 1,000); 0: all
+///       eval_poses: 32           # poses per character for validation and test, evenly spaced
+///       plateau: {factor: 0.75, patience: 8, min_lr: 5.0e-7}   # Sec. 3.4
+///       baseline: ""             # lbs or dqs: evaluate that deformer instead of a network
 struct CorrectiveOptions {
   std::string skeleton = "Biped";
   int frame_stride = 4;
   int max_poses_per_character = 0;
   double height_m = 1.75;
   geometry::DeltaMushOptions delta_mush;
+  int samples_per_epoch = 400;
+  int batch_size = 8;
+  int window = 1000;
+  int eval_poses = 32;
+  double plateau_factor = 0.75;
+  int plateau_patience = 8;
+  double plateau_min_lr = 5e-7;
+  std::string baseline;
   /// Decodes and checks the section (every field optional); errors name the file, line, key.
   static CorrectiveOptions from(const config::Node& node);
 };

@@ -13,6 +13,7 @@
 #include <iostream>
 
 #include "framework/cli/commands.hpp"
+#include "framework/cli/tasks.hpp"
 #include "framework/core/config.hpp"
 #include "framework/core/environment.hpp"
 #include "framework/core/run_dir.hpp"
@@ -42,7 +43,9 @@ RunDir create_binder_run(EvalArgs& args) {
     throw Error(args.run + ": has a 'model', which must be trained first: `skinlab train " +
                 args.run + "`, then `skinlab eval <its run directory>`");
   }
-  o.require_binder_sections(config);
+  if (!untrained_method(config, o)) {
+    o.require_binder_sections(config);  // names what an evaluated config needs
+  }
   args.options.overrides.clear();
   RunDir run = train::create_run(config, o, args.run_id, command_line());
   std::cout << "run: " << run.path().string() << "\n";
@@ -63,7 +66,7 @@ int run_eval(EvalArgs args) {
     set_torch_threads(train::RunOptions::from(config).threads);
   }
   args.options.predictions = !args.no_predictions;
-  const eval::EvalReport r = eval::evaluate(run, args.options);
+  const eval::EvalReport r = evaluate_run(run, args.options);
   std::cout << fmt::format("{} part of split '{}', {} characters, checkpoint {} (epoch {}), {:.1f} s\n",
                            r.part, r.split, r.characters.size(), r.checkpoint, r.epoch, r.seconds);
   for (const auto& [name, value] : r.mean) std::cout << fmt::format("  {}: {:.6g}\n", name, value);

@@ -32,6 +32,7 @@
 #include <optional>
 
 #include "framework/cli/commands.hpp"
+#include "framework/cli/tasks.hpp"
 #include "framework/core/atomic_file.hpp"
 #include "framework/core/config.hpp"
 #include "framework/core/environment.hpp"
@@ -107,7 +108,7 @@ fs::path run_entry(const Sweep& sweep, const Entry& entry, int threads) {
       e.part = sweep.part;
       e.predictions = sweep.predictions;
       if (threads >= 0) set_torch_threads(threads);
-      eval::evaluate(run, e);
+      evaluate_run(run, e);
     }
     return run.path();
   }
@@ -115,9 +116,8 @@ fs::path run_entry(const Sweep& sweep, const Entry& entry, int threads) {
   overrides.insert(overrides.end(), entry.overrides.begin(), entry.overrides.end());
   const config::Config config = config::Config::load(entry.config, overrides);
   const train::RunOptions o = train::RunOptions::from(config);
-  const bool binder = o.binder.exists();
-  if (binder) o.require_binder_sections(config);
-  else o.require_training_sections(config);
+  const bool binder = untrained_method(config, o);
+  if (!binder) o.require_training_sections(config);
   set_torch_threads(threads >= 0 ? threads : o.threads);
 
   const std::string run_id = entry.run_id.empty() ? sweep.name : entry.run_id;
@@ -130,11 +130,11 @@ fs::path run_entry(const Sweep& sweep, const Entry& entry, int threads) {
                   " resolves to now; move it away or rename the sweep");
     }
   }
-  std::cout << fmt::format("== {} ({}) → {}\n", entry.config, binder ? "binder" : "train",
+  std::cout << fmt::format("== {} ({}) → {}\n", entry.config, binder ? "evaluate only" : "train",
                            dir.string());
   std::optional<RunDir> run;
   if (!binder) {
-    train::Trainer trainer(config);
+    TaskTrainer trainer(config);
     run = existed ? RunDir::open(dir) : train::create_run(config, o, run_id, command_line());
     const train::TrainResult r = trainer.fit(*run);
     spdlog::info("{}: {} epochs, best epoch {} (validation loss {:.6g})", o.experiment, r.epochs,
@@ -145,7 +145,7 @@ fs::path run_entry(const Sweep& sweep, const Entry& entry, int threads) {
   eval::EvalOptions e;
   e.part = sweep.part;
   e.predictions = sweep.predictions;
-  const eval::EvalReport report = eval::evaluate(*run, e);
+  const eval::EvalReport report = evaluate_run(*run, e);
   std::cout << fmt::format("   {} characters, {:.1f} s\n", report.characters.size(), report.seconds);
   return run->path();
 }

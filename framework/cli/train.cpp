@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "framework/cli/commands.hpp"
+#include "framework/cli/tasks.hpp"
 #include "framework/core/config.hpp"
 #include "framework/core/atomic_file.hpp"
 #include "framework/core/environment.hpp"
@@ -65,8 +66,8 @@ int run_train(TrainArgs args) {
   const int threads = set_torch_threads(args.threads >= 0 ? args.threads : options.threads);
 
   // Everything that can fail on the config, the dataset or the model fails here, before a run
-  // directory exists.
-  train::Trainer trainer(*config);
+  // directory exists. The config's task decides the trainer.
+  TaskTrainer trainer(*config);
   if (!run) {
     run = train::create_run(*config, options, args.run_id, command_line());
   } else {
@@ -85,7 +86,7 @@ int run_train(TrainArgs args) {
       "{} {} epochs{} ({} this session, {:.1f} s); best epoch {} with {} loss {:.6g}\n",
       r.early_stopped ? "stopped early after" : "trained", r.epochs,
       r.resumed ? " in total" : "", r.epochs_this_call, r.seconds, r.best_epoch,
-      trainer.data().part("val").empty() ? "train" : "validation", r.best_loss);
+      trainer.validated() ? "validation" : "train", r.best_loss);
   std::cout << "checkpoints: " << run->file(train::kBestCheckpoint).string() << ", "
             << run->file(train::kLastCheckpoint).string() << "\n";
   return 0;

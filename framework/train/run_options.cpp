@@ -5,6 +5,7 @@
 #include "framework/binders/binder.hpp"
 #include "framework/core/registry.hpp"
 #include "framework/losses/loss.hpp"
+#include "framework/models/corrective_model.hpp"
 
 namespace skinlab::train {
 
@@ -53,6 +54,10 @@ RunOptions RunOptions::from(const config::Config& config) {
   f.optional("threads", o.threads).check(o.threads >= 0, "threads", "must be ≥ 0 (0 = every hardware thread)");
   f.optional("results_dir", o.results_dir)
       .check(!o.results_dir.empty(), "results_dir", "must not be empty");
+  f.optional("task", o.task)
+      .check(o.task == "skinning" || o.task == "corrective", "task",
+             "must be skinning (weights, the default) or corrective (DenseGATs)");
+  o.corrective = f.section("corrective");
   o.model = f.section("model");
   o.binder = f.section("binder");
   o.losses = f.section("losses");
@@ -61,7 +66,16 @@ RunOptions RunOptions::from(const config::Config& config) {
   const config::Node train = f.section("train");
   f.finish();
 
-  if (o.model.exists()) model_registry().create(o.model);
+  if (o.corrective.exists() && o.task != "corrective") {
+    o.corrective.fail("a 'corrective' section belongs to a config with task: corrective");
+  }
+  if (o.model.exists()) {
+    if (o.task == "corrective") {
+      corrective_model_registry().create(o.model);
+    } else {
+      model_registry().create(o.model);
+    }
+  }
   if (o.binder.exists()) {
     if (o.model.exists()) {
       o.binder.fail("a config has a 'model' (a network to train) or a 'binder' (weights from "

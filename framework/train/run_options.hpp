@@ -5,6 +5,9 @@
 /// misspelled option or unknown `type:` anywhere is reported before any work starts.
 ///
 ///     experiment: heterskinnet        # results go to <results_dir>/<experiment>/<run_id>/
+///     task: skinning                  # or corrective: DenseGATs' task (experiments/densegats),
+///                                     # whose model is a `corrective_model` and which reads a
+///                                     # `corrective:` section (validated by that task)
 ///     description: ...                # free text, saved with the run
 ///     seed: 0                         # every random choice of the run derives from it
 ///     threads: 0                      # libtorch intra-op threads; 0 = every hardware thread
@@ -73,6 +76,8 @@ struct RunOptions {
   std::int64_t seed = 0;
   int threads = 0;
   std::string results_dir = "results";
+  std::string task = "skinning";  ///< skinning or corrective
+  config::Node corrective;  ///< the corrective task's section (missing when absent)
   config::Node model;    ///< missing when the config has no model section
   config::Node binder;   ///< missing when the config has no binder section
   config::Node losses;   ///< missing when the config has no losses section

@@ -372,5 +372,55 @@ TEST(Cli, SmokeRunPrepareTrainEvalOnTheBundledSubset) {
   check_smoke_table3(dir, data, results);
 }
 
+
+// What CI runs of DenseGATs' task (issue 9): the bundled bipeds prepared, the smoke sweep of
+// configs/sweeps/densegats_smoke_table3.yaml (a tiny DenseGATs trained, the LBS and DQS rows
+// evaluated) through the binary, and its table.
+TEST(Cli, DenseGatsSmokeSweepOnTheBundledBipeds) {
+  TempDir dir;
+  const std::string data = (dir / "bipeds.h5").string();
+  const std::string results = (dir / "results").string();
+  const Result p =
+      run("prepare configs/datasets/zeroad_bipeds_bundled.yaml output=" + data + " --threads 2");
+  ASSERT_EQ(p.status, 0) << p.err;
+  std::string sweep = read_file(std::filesystem::path(SKINLAB_SOURCE_DIR) / "configs" / "sweeps" /
+                                "densegats_smoke_table3.yaml");
+  const std::string out_line = "out: results/tables/densegats_smoke_table3.md";
+  ASSERT_NE(sweep.find(out_line), std::string::npos) << sweep;
+  const std::filesystem::path table_md = dir / "table.md";
+  sweep.replace(sweep.find(out_line), out_line.size(), "out: " + table_md.string());
+  const std::string data_line = "data.file=results/datasets/zeroad_bipeds_bundled.h5";
+  ASSERT_NE(sweep.find(data_line), std::string::npos) << sweep;
+  sweep.replace(sweep.find(data_line), data_line.size(),
+                "data.file=" + data + ", results_dir=" + results);
+  const Result s = run("sweep " + dir.write("sweep.yaml", sweep).string());
+  ASSERT_EQ(s.status, 0) << s.err;
+
+  const std::string table = read_file(table_md);
+  std::vector<double> means;
+  for (const std::string experiment : {"densegats_smoke", "densegats_lbs", "densegats_dqs"}) {
+    EXPECT_NE(table.find("| " + experiment + " | densegats_smoke_table3 | "), std::string::npos)
+        << experiment << "\n" << table;
+    const auto report = nlohmann::json::parse(read_file(
+        std::filesystem::path(results) / experiment / "densegats_smoke_table3" / "eval_test.json"));
+    ASSERT_EQ(report["per_character"].size(), 1u) << experiment;
+    EXPECT_EQ(report["task"], "corrective");
+    const auto& m = report["mean"];
+    EXPECT_EQ(m["poses"].get<double>(), 4.0) << experiment;
+    EXPECT_GT(m["mean_error_cm"].get<double>(), 0.0) << experiment;
+    EXPECT_LE(m["min_error_cm"].get<double>(), m["mean_error_cm"].get<double>()) << experiment;
+    EXPECT_LE(m["mean_error_cm"].get<double>(), m["max_error_cm"].get<double>()) << experiment;
+    means.push_back(m["mean_error_cm"].get<double>());
+  }
+  EXPECT_NE(means[1], means[2]);  // LBS and DQS differ
+  EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(results) / "densegats_smoke" /
+                                      "densegats_smoke_table3" / "best.pt"));
+  EXPECT_FALSE(std::filesystem::exists(std::filesystem::path(results) / "densegats_lbs" /
+                                       "densegats_smoke_table3" / "best.pt"));
+  // A corrective config without a model or baseline cannot be evaluated, and says why.
+  const Result e = run("eval configs/densegats/task.yaml data.file=" + data);
+  EXPECT_NE(e.status, 0);
+}
+
 }  // namespace
 }  // namespace skinlab

@@ -10,46 +10,15 @@
 #include <set>
 
 #include "framework/core/error.hpp"
-#include "framework/data/prepare.hpp"
 #include "framework/geometry/lbs.hpp"
+#include "tests/densegats/densegats_fixtures.hpp"
 #include "tests/test_util.hpp"
 
 namespace skinlab::densegats {
 namespace {
 
 using skinlab::testing::expect_error;
-
-/// The bundled bipeds, prepared once for the whole suite.
-class CorrectiveDataTest : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    dir_ = new skinlab::testing::TempDir();
-    file_ = (*dir_ / "bipeds.h5").string();
-    const std::string source = std::string(SKINLAB_SOURCE_DIR);
-    data::PrepareOptions quiet;
-    quiet.threads = 2;
-    quiet.progress = false;
-    data::prepare_dataset(
-        data::PrepareConfig::from(config::Config::load(
-            source + "/configs/datasets/zeroad_bipeds_bundled.yaml",
-            {"output=" + file_,
-             "sources=[{type: zeroad, path: " + source + "/datasets/zeroad/bundled}]"})),
-        quiet);
-    dataset_ = new data::Dataset(data::read_dataset(file_));
-  }
-  static void TearDownTestSuite() {
-    delete dataset_;
-    delete dir_;
-  }
-  static CorrectiveOptions options(int stride = 8) {
-    CorrectiveOptions o;
-    o.frame_stride = stride;
-    return o;
-  }
-  static inline skinlab::testing::TempDir* dir_ = nullptr;
-  static inline std::string file_;
-  static inline data::Dataset* dataset_ = nullptr;
-};
+using CorrectiveDataTest = BundledBipeds;
 
 TEST_F(CorrectiveDataTest, TheBundledBipedsShareTheirElevenClips) {
   const CorrectiveData data(*dataset_, file_, options());

@@ -1,0 +1,38 @@
+#pragma once
+/// \file
+/// The task dispatch of the commands that train or evaluate (`train`, `eval`, `sweep`): a
+/// config's `task:` (train/run_options.hpp) picks the skinning Trainer and evaluator, or the
+/// corrective-deformation task's (experiments/densegats/corrective_task.hpp).
+
+#include <memory>
+
+#include "experiments/densegats/corrective_task.hpp"
+#include "framework/core/config.hpp"
+#include "framework/core/run_dir.hpp"
+#include "framework/eval/evaluator.hpp"
+#include "framework/train/run_options.hpp"
+#include "framework/train/trainer.hpp"
+
+namespace skinlab::cli {
+
+/// A method that is not trained: a skinning `binder`, or a corrective `baseline`. Checks that
+/// the sections evaluating it needs are there (ConfigError otherwise).
+bool untrained_method(const config::Config& config, const train::RunOptions& options);
+
+/// The trainer of the config's task, built (and so validated) before any run directory exists.
+class TaskTrainer {
+ public:
+  explicit TaskTrainer(const config::Config& config);
+  train::TrainResult fit(const RunDir& run, const train::FitLimits& limits = {});
+  /// Whether the best checkpoint was selected on validation data (else the train loss).
+  bool validated() const;
+
+ private:
+  std::unique_ptr<train::Trainer> skinning_;
+  std::unique_ptr<densegats::CorrectiveTrainer> corrective_;
+};
+
+/// Evaluates a run of either task (its config.yaml says which).
+eval::EvalReport evaluate_run(const RunDir& run, const eval::EvalOptions& options);
+
+}  // namespace skinlab::cli
