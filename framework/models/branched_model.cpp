@@ -40,40 +40,51 @@ torch::Tensor inverse_distance(const torch::Tensor& topk_distance,
   return (topk_distance / options.distance_unit).clamp_min(options.min_distance).reciprocal();
 }
 
-BranchedNetwork::BranchedNetwork(std::string name, const BranchedModelOptions& options,
-                                 std::int64_t input_width,
-                                 const std::vector<std::int64_t>& input_mlp)
-    : name_(std::move(name)), top_k_(options.top_k) {
-  input_ = register_module("input", graph::Mlp(input_width, graph::MlpOptions{input_mlp}));
-  stem_ = register_module("stem", graph::Sequence::from(options.stem));
-  local_ = register_module("local", graph::Sequence::from(options.local));
-  global_ = register_module("global_branch", graph::graph_op_from(options.global));
-  const graph::Dims in{input_->out_width(), 6, top_k_};
+BranchedLayers::BranchedLayers(torch::nn::Module& owner, const std::string& name,
+                               const BranchedModelOptions& options, std::int64_t input_width,
+                               const std::vector<std::int64_t>& input_mlp, std::int64_t bone_width,
+                               std::int64_t outputs) {
+  input_ = owner.register_module("input", graph::Mlp(input_width, graph::MlpOptions{input_mlp}));
+  stem_ = owner.register_module("stem", graph::Sequence::from(options.stem));
+  local_ = owner.register_module("local", graph::Sequence::from(options.local));
+  global_ = owner.register_module("global_branch", graph::graph_op_from(options.global));
+  const graph::Dims in{input_->out_width(), bone_width, options.top_k};
   const graph::Dims x = stem_->build(in);
   const graph::Dims g = global_->build(x);
   const graph::Dims l = local_->build(x);
-  TORCH_CHECK(l.vertex >= 1, name_, ": the local branch must end with vertex features");
-  TORCH_CHECK(g.vertex >= 1, name_, ": the global branch must give the vertices a feature");
+  TORCH_CHECK(l.vertex >= 1, name, ": the local branch must end with vertex features");
+  TORCH_CHECK(g.vertex >= 1, name, ": the global branch must give the vertices a feature");
   graph::MlpOptions head;
   head.widths = options.head;
-  head.widths.push_back(top_k_);
+  head.widths.push_back(outputs);
   head.activate_last = false;
   head.dropout = options.head_dropout;
-  head_ = register_module("head", graph::Mlp(l.vertex + g.vertex, std::move(head)));
+  head_ = owner.register_module("head", graph::Mlp(l.vertex + g.vertex, std::move(head)));
 }
+
+torch::Tensor BranchedLayers::forward(const torch::Tensor& features, const torch::Tensor& bones,
+                                      const graph::Graph& graph) {
+  graph::Features in;
+  in.vertex = input_->forward(features);
+  in.bone = bones;
+  const graph::Features x = stem_->forward(in, graph);
+  const graph::Features glob = global_->forward(x, graph);
+  const graph::Features loc = local_->forward(x, graph);
+  return head_->forward(torch::cat({loc.vertex, glob.vertex}, 1));
+}
+
+BranchedNetwork::BranchedNetwork(std::string name, const BranchedModelOptions& options,
+                                 std::int64_t input_width,
+                                 const std::vector<std::int64_t>& input_mlp)
+    : name_(std::move(name)),
+      top_k_(options.top_k),
+      layers_(*this, name_, options, input_width, input_mlp, 6, options.top_k) {}
 
 torch::Tensor BranchedNetwork::forward(const data::CharacterTensors& c) {
   TORCH_CHECK(c.top_k() == top_k_, name_, ": built for top_k = ", top_k_, " but character '",
               c.name, "' has ", c.top_k(),
               " candidate bones per vertex (set model.top_k to the dataset's top_k)");
-  const graph::Graph g = graph::make_graph(c);
-  graph::Features in;
-  in.vertex = input_->forward(input_features(c));
-  in.bone = c.bones;
-  const graph::Features x = stem_->forward(in, g);
-  const graph::Features glob = global_->forward(x, g);
-  const graph::Features loc = local_->forward(x, g);
-  return torch::softmax(head_->forward(torch::cat({loc.vertex, glob.vertex}, 1)), 1);
+  return torch::softmax(layers_.forward(input_features(c), c.bones, graph::make_graph(c)), 1);
 }
 
 }  // namespace skinlab::models

@@ -57,6 +57,32 @@ torch::Tensor inverse_distance(const torch::Tensor& topk_distance,
 /// Submodules `input`, `stem`, `local`, `global_branch` ("global" is a Python keyword, which
 /// libtorch checkpoints cannot store as a module name) and `head`. Bone attributes [start, end]
 /// (width 6) ride along, so a config may add skeleton ops; neither baseline uses any.
+/// The layers of a branched network: MLP_input → stem → (global ‖ local) → head, registered on
+/// `owner` under the names `input`, `stem`, `local`, `global_branch` and `head`. Shared by the
+/// skinning BranchedNetwork (RigNet's and NeuroSkinning's networks) and the corrective task's
+/// NeuroSkinning network (experiments/densegats), which differ in inputs and outputs only.
+class BranchedLayers {
+ public:
+  BranchedLayers() = default;
+  /// `name` prefixes messages; `input_width` is the width of f_v, `input_mlp` the widths of
+  /// MLP_input, `bone_width` the width of the bone features the stem receives (0: none) and
+  /// `outputs` the head's last width (no activation after it).
+  BranchedLayers(torch::nn::Module& owner, const std::string& name,
+                 const BranchedModelOptions& options, std::int64_t input_width,
+                 const std::vector<std::int64_t>& input_mlp, std::int64_t bone_width,
+                 std::int64_t outputs);
+  /// #V×outputs: the head on [local ‖ global] for #V×input_width `features` and the bone
+  /// features `bones` (undefined when bone_width is 0).
+  torch::Tensor forward(const torch::Tensor& features, const torch::Tensor& bones,
+                        const graph::Graph& graph);
+  graph::Mlp& head() { return head_; }
+
+ private:
+  graph::Mlp input_{nullptr}, head_{nullptr};
+  std::shared_ptr<graph::Sequence> stem_, local_;
+  std::shared_ptr<graph::GraphOp> global_;
+};
+
 class BranchedNetwork : public Model {
  public:
   /// #V×K softmax over the candidates `c.topk_index`.
@@ -73,9 +99,7 @@ class BranchedNetwork : public Model {
  private:
   std::string name_;
   std::int64_t top_k_;
-  graph::Mlp input_{nullptr}, head_{nullptr};
-  std::shared_ptr<graph::Sequence> stem_, local_;
-  std::shared_ptr<graph::GraphOp> global_;
+  BranchedLayers layers_;
 };
 
 }  // namespace skinlab::models

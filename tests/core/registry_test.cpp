@@ -106,7 +106,7 @@ TEST(Registry, ExactKeysOfEveryCategory) {
       {"graph_op",
        {"b2v", "edge_conv", "gat_block", "gconv_pool", "global_pool", "mesh_conv", "v2b"}},
       {"model", {"heterskinnet", "neuroskinning", "rignet_skin"}},
-      {"corrective_model", {"densegats"}},
+      {"corrective_model", {"densegats", "neuroskinning"}},
       {"loss", {"kl", "laplacian_smoothing", "mse", "soft_cross_entropy"}},
       {"metric", {"avg_l1", "deformation_error", "precision_recall"}},
       {"dataset", {"cube2", "folder", "nexuiz", "zeroad"}},

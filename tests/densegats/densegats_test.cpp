@@ -161,5 +161,41 @@ TEST(DenseGats, ConfigErrorsAreReportedAtConfigTime) {
   }
 }
 
+
+TEST(NeuroSkinningCorrective, ThePaperWidthsGiveADisplacementThatStartsAtZero) {
+  const config::Config file = config::Config::load(
+      std::string(SKINLAB_SOURCE_DIR) + "/configs/densegats/neuroskinning.yaml");
+  torch::manual_seed(0);
+  auto model = corrective_model_registry().create(file.root()["model"]);
+  EXPECT_EQ(model->input_width(), 52);
+  const graph::Graph g = tube_graph();
+  const torch::Tensor x = torch::randn({g.num_vertices, 52});
+  const torch::Tensor out = model->forward(x, g);
+  EXPECT_EQ(out.sizes(), (std::vector<std::int64_t>{g.num_vertices, 3}));
+  EXPECT_EQ(out.abs().max().item<float>(), 0.0f);
+  // The skinning network's layer names (input, stem, local, global_branch, head), one of them
+  // the 1024-wide global feature.
+  bool global = false;
+  for (const auto& p : model->named_parameters()) {
+    global |= p.key().rfind("global_branch.", 0) == 0 && p.value().size(0) == 1024;
+  }
+  EXPECT_TRUE(global);
+  {
+    torch::NoGradGuard no_grad;
+    for (auto& p : model->named_parameters()) {
+      if (p.key().rfind("head.linear2", 0) == 0) p.value().normal_(0, 0.1);
+    }
+  }
+  model->forward(x, g).pow(2).sum().backward();
+  for (const auto& p : model->named_parameters()) {
+    ASSERT_TRUE(p.value().grad().defined()) << p.key();
+    EXPECT_GT(p.value().grad().abs().max().item<float>(), 0.0f) << p.key();
+  }
+  EXPECT_THROW(model->forward(torch::randn({g.num_vertices, 50}), g), c10::Error);
+  EXPECT_THROW(corrective_model_registry().create(
+                   config::Config::parse("{type: neuroskinning, top_kk: 3}").root()),
+               ConfigError);
+}
+
 }  // namespace
 }  // namespace skinlab::experiments
