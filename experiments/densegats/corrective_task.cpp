@@ -311,15 +311,7 @@ train::TrainResult CorrectiveTrainer::fit(const RunDir& run, const train::FitLim
       break;
     }
   }
-  result.early_stopped = stopped_early() && state.epoch < t.epochs;
-  if (result.early_stopped && !result.interrupted) {
-    spdlog::info("early stopping after epoch {}: no improvement for {} epochs (best epoch {})",
-                 state.epoch, t.patience, state.best_epoch);
-  }
-  result.epochs = static_cast<int>(state.epoch);
-  result.best_epoch = static_cast<int>(state.best_epoch);
-  result.best_loss = state.best_loss;
-  result.seconds = seconds_since(start);
+  train::finish_fit(result, state, t, stopped_early(), start);
   return result;
 }
 

@@ -76,4 +76,17 @@ void truncate_metrics(const RunDir& run, std::int64_t epoch) {
   }
 }
 
+void finish_fit(TrainResult& result, const TrainingState& state, const TrainOptions& options,
+                bool stopped_early, std::chrono::steady_clock::time_point start) {
+  result.early_stopped = stopped_early && state.epoch < options.epochs;
+  if (result.early_stopped && !result.interrupted) {
+    spdlog::info("early stopping after epoch {}: no improvement for {} epochs (best epoch {})",
+                 state.epoch, options.patience, state.best_epoch);
+  }
+  result.epochs = static_cast<int>(state.epoch);
+  result.best_epoch = static_cast<int>(state.best_epoch);
+  result.best_loss = state.best_loss;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 }  // namespace skinlab::train

@@ -8,12 +8,16 @@
 #include <ATen/core/Generator.h>
 #include <torch/torch.h>
 
+#include <chrono>
 #include <cstdint>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 
 #include "framework/core/run_dir.hpp"
+#include "framework/train/checkpoint.hpp"
+#include "framework/train/run_options.hpp"
+#include "framework/train/trainer.hpp"
 
 namespace skinlab::train {
 
@@ -40,5 +44,10 @@ void remove_stale_temporaries(const RunDir& run);
 /// Keeps the metrics.jsonl records of epochs ≤ `epoch` (a killed run may have logged an epoch
 /// whose checkpoint it never wrote; that epoch is trained again).
 void truncate_metrics(const RunDir& run, std::int64_t epoch);
+
+/// The end of a fit: sets `result`'s early_stopped (logging it unless the fit was interrupted),
+/// epochs, best epoch and loss from the final `state`, and the wall time since `start`.
+void finish_fit(TrainResult& result, const TrainingState& state, const TrainOptions& options,
+                bool stopped_early, std::chrono::steady_clock::time_point start);
 
 }  // namespace skinlab::train

@@ -260,15 +260,7 @@ TrainResult Trainer::fit(const RunDir& run, const FitLimits& limits) {
       break;
     }
   }
-  result.early_stopped = stopped_early() && state.epoch < t.epochs;
-  if (result.early_stopped && !result.interrupted) {
-    spdlog::info("early stopping after epoch {}: no improvement for {} epochs (best epoch {})",
-                 state.epoch, t.patience, state.best_epoch);
-  }
-  result.epochs = static_cast<int>(state.epoch);
-  result.best_epoch = static_cast<int>(state.best_epoch);
-  result.best_loss = state.best_loss;
-  result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  finish_fit(result, state, t, stopped_early(), start);
   return result;
 }
 
