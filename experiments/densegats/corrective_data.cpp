@@ -7,6 +7,7 @@
 #include <map>
 
 #include "framework/core/error.hpp"
+#include "framework/data/tensors.hpp"
 #include "framework/geometry/lbs.hpp"
 #include "framework/geometry/orient_outward.hpp"
 #include "framework/geometry/vertex_normals.hpp"
@@ -38,16 +39,6 @@ Eigen::Isometry3d conjugate(const Eigen::Matrix4d& N, const Eigen::Matrix4d& N_i
   out.linear() = Eigen::Quaterniond(Eigen::Matrix3d(m.topLeftCorner<3, 3>())).normalized().toRotationMatrix();
   out.translation() = m.topRightCorner<3, 1>();
   return out;
-}
-
-torch::Tensor edge_tensor(const data::RowMatrixXi& edges) {
-  torch::Tensor t = torch::empty({edges.rows(), 2}, torch::kInt64);
-  auto a = t.accessor<std::int64_t, 2>();
-  for (Eigen::Index e = 0; e < edges.rows(); ++e) {
-    a[e][0] = edges(e, 0);
-    a[e][1] = edges(e, 1);
-  }
-  return t;
 }
 
 }  // namespace
@@ -177,7 +168,7 @@ CorrectiveData::CorrectiveData(const data::Dataset& dataset, const std::string& 
       out.bind_inverse.push_back(rigid_from(own.bind.data() + static_cast<std::size_t>(j) * 12).inverse());
     }
     out.mush = std::make_shared<const geometry::DeltaMush>(out.mesh, options.delta_mush, c.name);
-    out.one_ring = edge_tensor(c.one_ring_edges);
+    out.one_ring = data::to_long(c.one_ring_edges);
     out.poses = poses;
     characters_.push_back(std::move(out));
   }
@@ -241,17 +232,13 @@ torch::Tensor CorrectiveData::features(int character, const Eigen::MatrixXd& pos
 
 CorrectiveSample CorrectiveData::sample(int character, int pose) const {
   const CorrectiveCharacter& c = characters_.at(static_cast<std::size_t>(character));
-  const std::vector<Eigen::Affine3d> T = transforms(character, pose);
   CorrectiveSample s;
-  s.lbs = geometry::lbs(c.mesh.V, c.weights, T);
+  s.transforms = transforms(character, pose);
+  s.lbs = geometry::lbs(c.mesh.V, c.weights, s.transforms);
   s.target = c.mush->deform(s.lbs, &s.passthrough);
   s.displacement = (s.target - s.lbs) * cm_per_unit();
-  s.features = features(character, s.lbs, T);
-  s.displacement_t = torch::empty({s.lbs.rows(), 3}, torch::kFloat32);
-  auto a = s.displacement_t.accessor<float, 2>();
-  for (Eigen::Index i = 0; i < s.lbs.rows(); ++i) {
-    for (int k = 0; k < 3; ++k) a[i][k] = static_cast<float>(s.displacement(i, k));
-  }
+  s.features = features(character, s.lbs, s.transforms);
+  s.displacement_t = data::to_float(data::RowMatrixXd(s.displacement));
   return s;
 }
 

@@ -117,6 +117,7 @@ struct CorrectiveCharacter {
 /// One (character, pose) sample. Matrices are #V×3 in the character's normalised frame, root at
 /// its bind pose; displacements in cm.
 struct CorrectiveSample {
+  std::vector<Eigen::Affine3d> transforms;  ///< #J skinning transforms of the pose (transforms())
   Eigen::MatrixXd lbs;           ///< t(S): the artist-weighted LBS mesh
   Eigen::MatrixXd target;        ///< Delta Mush(lbs)
   Eigen::MatrixXd displacement;  ///< (target − lbs) · cm per unit: what the network predicts

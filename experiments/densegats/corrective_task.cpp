@@ -265,13 +265,7 @@ train::TrainResult CorrectiveTrainer::fit(const RunDir& run, const train::FitLim
     const double train_loss = train_sum / static_cast<double>(steps);
     const double val_loss = have_val ? validation_loss() : std::nan("");
     const double selection = have_val ? val_loss : train_loss;
-    const bool improved = std::isfinite(selection) &&
-                          (state.best_epoch == 0 || selection < state.best_loss - t.min_delta);
-    state.epoch = epoch;
-    if (improved) {
-      state.best_epoch = epoch;
-      state.best_loss = selection;
-    }
+    const bool improved = train::record_epoch(state, epoch, selection, t.min_delta);
     // ReduceLROnPlateau (mode min, threshold 0): decay after more than `patience` bad epochs.
     const double used_lr = lr;
     if (selection < plateau_best) {
@@ -373,7 +367,7 @@ eval::EvalReport evaluate_corrective(const RunDir& run, const eval::EvalOptions&
         for (Eigen::Index i = 0; i < correction.rows(); ++i)
           for (int k = 0; k < 3; ++k) correction(i, k) = a[i][k];
       } else if (baseline == "dqs") {
-        correction = (geometry::dqs(ch.mesh.V, ch.weights, data->transforms(index, pose)) - s.lbs) *
+        correction = (geometry::dqs(ch.mesh.V, ch.weights, s.transforms) - s.lbs) *
                      data->cm_per_unit();
       }
       const Eigen::VectorXd error = (correction - s.displacement).rowwise().norm();

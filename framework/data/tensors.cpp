@@ -14,6 +14,8 @@ torch::Tensor to_float(const RowMatrixXf& m) {
       .clone();
 }
 
+}  // namespace
+
 torch::Tensor to_float(const RowMatrixXd& m) {
   return torch::from_blob(const_cast<double*>(m.data()), {m.rows(), m.cols()}, torch::kFloat64)
       .to(torch::kFloat32);
@@ -23,8 +25,6 @@ torch::Tensor to_long(const RowMatrixXi& m) {
   return torch::from_blob(const_cast<int*>(m.data()), {m.rows(), m.cols()}, torch::kInt32)
       .to(torch::kInt64);
 }
-
-}  // namespace
 
 CharacterTensors to_tensors(const PreparedCharacter& character, const std::string& distance) {
   const auto it = character.distances.find(distance);

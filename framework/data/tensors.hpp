@@ -52,6 +52,11 @@ struct CharacterTensors {
 /// character and listing the distance types it has when `distance` is not among them.
 CharacterTensors to_tensors(const PreparedCharacter& character, const std::string& distance);
 
+/// A float32 copy of `m` (rows × cols), e.g. vertex positions.
+torch::Tensor to_float(const RowMatrixXd& m);
+/// An int64 copy of `m`, e.g. an #E×2 edge list.
+torch::Tensor to_long(const RowMatrixXi& m);
+
 /// #V×#B bone weights from a #V×K distribution over the candidates `topk_index` (#V×K):
 /// out[v, topk_index[v, k]] = pred[v, k], zero elsewhere. Differentiable in `pred`.
 torch::Tensor scatter_to_bones(const torch::Tensor& pred, const torch::Tensor& topk_index,

@@ -76,6 +76,17 @@ void truncate_metrics(const RunDir& run, std::int64_t epoch) {
   }
 }
 
+bool record_epoch(TrainingState& state, std::int64_t epoch, double selection, double min_delta) {
+  const bool improved = std::isfinite(selection) &&
+                        (state.best_epoch == 0 || selection < state.best_loss - min_delta);
+  state.epoch = epoch;
+  if (improved) {
+    state.best_epoch = epoch;
+    state.best_loss = selection;
+  }
+  return improved;
+}
+
 void finish_fit(TrainResult& result, const TrainingState& state, const TrainOptions& options,
                 bool stopped_early, std::chrono::steady_clock::time_point start) {
   result.early_stopped = stopped_early && state.epoch < options.epochs;

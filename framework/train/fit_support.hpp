@@ -45,6 +45,11 @@ void remove_stale_temporaries(const RunDir& run);
 /// whose checkpoint it never wrote; that epoch is trained again).
 void truncate_metrics(const RunDir& run, std::int64_t epoch);
 
+/// Records that epoch `epoch` ended with selection loss `selection` (validation loss, or the
+/// train loss without validation): sets state.epoch and, when it improved (finite, and the first
+/// or below best_loss − min_delta), best_epoch and best_loss. Returns whether it improved.
+bool record_epoch(TrainingState& state, std::int64_t epoch, double selection, double min_delta);
+
 /// The end of a fit: sets `result`'s early_stopped (logging it unless the fit was interrupted),
 /// epochs, best epoch and loss from the final `state`, and the wall time since `start`.
 void finish_fit(TrainResult& result, const TrainingState& state, const TrainOptions& options,

@@ -217,13 +217,7 @@ TrainResult Trainer::fit(const RunDir& run, const FitLimits& limits) {
     std::map<std::string, double> val_parts;
     const double val_loss = have_val ? mean_loss("val", &val_parts) : std::nan("");
     const double selection = have_val ? val_loss : train_loss;
-    const bool improved = std::isfinite(selection) &&
-                          (state.best_epoch == 0 || selection < state.best_loss - t.min_delta);
-    state.epoch = epoch;
-    if (improved) {
-      state.best_epoch = epoch;
-      state.best_loss = selection;
-    }
+    const bool improved = record_epoch(state, epoch, selection, t.min_delta);
     state.torch_rng = get_rng_state(torch_rng);
     state.order_rng = get_rng_state(order_rng);
     const double seconds = std::chrono::duration<double>(Clock::now() - epoch_start).count();

@@ -89,6 +89,8 @@ TEST_F(CorrectiveDataTest, SamplesAreTheLbsMeshItsFeaturesAndDeltaMushsCorrectio
     ASSERT_GE(pose, 0) << ch.name;
     const CorrectiveSample s = data.sample(c, pose);
     const auto T = data.transforms(c, pose);
+    ASSERT_EQ(s.transforms.size(), T.size());
+    for (std::size_t j = 0; j < T.size(); ++j) EXPECT_TRUE(s.transforms[j].isApprox(T[j], 1e-15));
     EXPECT_TRUE(s.lbs.isApprox(geometry::lbs(ch.mesh.V, ch.weights, T), 1e-12));
     EXPECT_TRUE(s.target.isApprox(ch.mush->deform(s.lbs), 1e-12));
     EXPECT_TRUE(s.displacement.isApprox((s.target - s.lbs) * 175.0, 1e-12));

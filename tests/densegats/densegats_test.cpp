@@ -35,6 +35,15 @@ std::shared_ptr<models::CorrectiveModel> make(const std::string& yaml) {
 
 DenseGats& as_densegats(models::CorrectiveModel& m) { return dynamic_cast<DenseGats&>(m); }
 
+/// Draws the parameters whose names start with `prefix` from N(0, sd²): the output layers start
+/// at zero, which would stop every gradient behind them.
+void randomize(models::CorrectiveModel& model, const std::string& prefix, double sd) {
+  torch::NoGradGuard no_grad;
+  for (auto& p : model.named_parameters()) {
+    if (p.key().rfind(prefix, 0) == 0) p.value().normal_(0, sd);
+  }
+}
+
 TEST(DenseGats, ThePapersNetworkHasItsWidths) {
   auto model = make("{type: densegats}");
   DenseGats& d = as_densegats(*model);
@@ -77,12 +86,7 @@ TEST(DenseGats, AblationsAndTheOriginalGatAreConfigs) {
 
 TEST(DenseGats, GradientsReachEveryParameter) {
   auto model = make("{type: densegats, modules: 2, blocks_per_module: 2}");
-  {
-    torch::NoGradGuard no_grad;
-    for (auto& p : model->named_parameters()) {
-      if (p.key().rfind("out.", 0) == 0) p.value().normal_(0, 0.1);
-    }
-  }
+  randomize(*model, "out.", 0.1);
   const graph::Graph g = tube_graph();
   model->train();
   model->forward(torch::randn({g.num_vertices, 52}), g).pow(2).sum().backward();
@@ -97,12 +101,7 @@ TEST(DenseGats, GradientsMatchFiniteDifferences) {
       "{type: densegats, input_width: 5, feature_mlp: [4], modules: 2, blocks_per_module: 2, "
       "head: [4], batch_norm: false, block: {type: gat_block, heads: 2, hidden: 2, beta: 0.5}}");
   model->to(torch::kFloat64);
-  {
-    torch::NoGradGuard no_grad;
-    for (auto& p : model->named_parameters()) {
-      if (p.key().rfind("out.", 0) == 0) p.value().normal_(0, 0.5);
-    }
-  }
+  randomize(*model, "out.", 0.5);
   const graph::Graph g = tube_graph();
   const torch::Tensor x = torch::randn({g.num_vertices, 5}, torch::kFloat64).requires_grad_();
   const torch::Tensor w = torch::randn({g.num_vertices, 3}, torch::kFloat64);
@@ -124,12 +123,7 @@ TEST(DenseGats, GradientsMatchFiniteDifferences) {
 
 TEST(DenseGats, BatchStatisticsOnlyInTraining) {
   auto model = make("{type: densegats, modules: 1, blocks_per_module: 2}");
-  {
-    torch::NoGradGuard no_grad;
-    for (auto& p : model->named_parameters()) {
-      if (p.key().rfind("out.", 0) == 0) p.value().normal_(0, 0.1);
-    }
-  }
+  randomize(*model, "out.", 0.1);
   const graph::Graph g = tube_graph();
   const torch::Tensor x = torch::randn({g.num_vertices, 52});
   model->eval();
@@ -180,12 +174,7 @@ TEST(NeuroSkinningCorrective, ThePaperWidthsGiveADisplacementThatStartsAtZero) {
     global |= p.key().rfind("global_branch.", 0) == 0 && p.value().size(0) == 1024;
   }
   EXPECT_TRUE(global);
-  {
-    torch::NoGradGuard no_grad;
-    for (auto& p : model->named_parameters()) {
-      if (p.key().rfind("head.linear2", 0) == 0) p.value().normal_(0, 0.1);
-    }
-  }
+  randomize(*model, "head.linear2", 0.1);
   model->forward(x, g).pow(2).sum().backward();
   for (const auto& p : model->named_parameters()) {
     ASSERT_TRUE(p.value().grad().defined()) << p.key();
