@@ -7,6 +7,10 @@
 /// (`predictions/<part>.h5`, written by `skinlab eval`), the dataset its config names, and the
 /// run's own `metrics:` options (pruning, poses), so the maps average to the run's eval numbers.
 /// Writes `<out>/README.md` with the captions and the command.
+///
+/// Runs of the corrective task (`task: corrective`) get DenseGATs' error-colour figures instead
+/// (experiments/densegats/corrective_figure.hpp): the ground truth and each run's deformed mesh
+/// coloured by its per-vertex error in cm, at `--poses` evaluation poses per character.
 
 #include <fmt/format.h>
 
@@ -17,6 +21,7 @@
 #include <memory>
 #include <numeric>
 
+#include "experiments/densegats/corrective_figure.hpp"
 #include "framework/cli/commands.hpp"
 #include "framework/core/atomic_file.hpp"
 #include "framework/core/config.hpp"
@@ -122,6 +127,8 @@ Command add_figure(CLI::App& app) {
     std::vector<std::string> characters;
     int count = 3;
     double l1_max = 1.0;
+    int poses = 3;
+    double error_max_cm = 0;
     std::string out;
   };
   auto args = std::make_shared<Args>();
@@ -136,9 +143,36 @@ Command add_figure(CLI::App& app) {
   cmd->add_option("--l1-max", args->l1_max, "top of the L1 colour scale (L1 is in [0, 2])")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  cmd->add_option("--poses", args->poses,
+                  "corrective runs: evaluation poses per character, evenly spaced")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--error-max", args->error_max_cm,
+                  "corrective runs: top of the error colour scale in cm (default: each "
+                  "figure's 99th percentile)")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--out", args->out, "output directory")->required();
   return {
       cmd, [args] {
+        if (densegats::is_corrective_run(args->runs.front())) {
+          densegats::CorrectiveFigureOptions o;
+          o.part = args->part;
+          o.characters = args->characters;
+          o.count = args->count;
+          o.poses = args->poses;
+          o.error_max_cm = args->error_max_cm;
+          o.out = args->out;
+          o.command = "skinlab figure " + fmt::format("{}", fmt::join(args->runs, " ")) +
+                      fmt::format(" --part {} --poses {} --out {}", args->part, args->poses,
+                                  args->out);
+          if (!args->characters.empty())
+            o.command += fmt::format(" --characters {}", fmt::join(args->characters, ","));
+          else
+            o.command += fmt::format(" --count {}", args->count);
+          if (args->error_max_cm > 0) o.command += fmt::format(" --error-max {}", args->error_max_cm);
+          densegats::write_corrective_figures(args->runs, o);
+          return 0;
+        }
         std::vector<FigureRun> runs;
         for (const auto& dir : args->runs) runs.push_back(open_run(dir, args->part));
         std::vector<std::string> names = args->characters;

@@ -130,6 +130,21 @@ fs::path run_entry(const Sweep& sweep, const Entry& entry, int threads) {
                   " resolves to now; move it away or rename the sweep");
     }
   }
+  // A committed run keeps its evaluation but not its checkpoints (git ignores *.pt): its saved
+  // evaluation is its row. Without both it can neither resume nor be evaluated, and training
+  // it again from scratch would overwrite its history, so that is an error.
+  if (existed && !binder && !fs::exists(dir / train::kLastCheckpoint)) {
+    if (fs::exists(dir / ("eval_" + sweep.part + ".json"))) {
+      std::cout << fmt::format("== {} → {} (saved evaluation; no checkpoint to resume)\n",
+                               entry.config, dir.string());
+      return dir;
+    }
+    if (fs::exists(dir / "metrics.jsonl") && fs::file_size(dir / "metrics.jsonl") > 0) {
+      throw Error(fmt::format("{}: has trained epochs (metrics.jsonl) but neither {} nor "
+                              "eval_{}.json; move it away to train it again",
+                              dir.string(), train::kLastCheckpoint, sweep.part));
+    }
+  }
   std::cout << fmt::format("== {} ({}) → {}\n", entry.config, binder ? "evaluate only" : "train",
                            dir.string());
   std::optional<RunDir> run;

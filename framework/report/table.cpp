@@ -139,6 +139,9 @@ RunResult load_run_result(const fs::path& dir, const std::string& part) {
     r.part = j.at("part").get<std::string>();
     r.checkpoint = j.at("checkpoint").get<std::string>();
     r.epoch = j.at("epoch").get<int>();
+    if (j.contains("metric_definitions")) {
+      r.metric_definitions = j.at("metric_definitions").get<std::string>();
+    }
     for (const auto& c : j.at("per_character")) {
       r.characters.push_back(c.at("character").get<std::string>());
       for (const auto& [name, v] : c.at("values").items()) {
@@ -237,7 +240,9 @@ std::string make_table(const std::vector<RunResult>& runs, const TableOptions& o
                        "standard deviation over characters", ref.characters.size(), ref.part,
                        ref.split, ref.dataset);
     out += ".\n";
-    if (!ref.metrics_yaml.empty()) {
+    if (!ref.metric_definitions.empty()) {
+      out += "Metrics (the first run's evaluation): " + ref.metric_definitions + "\n";
+    } else if (!ref.metrics_yaml.empty() && ref.metrics_yaml != "[]") {
       out += "Metric definitions and thresholds (the first run's config):\n\n```yaml\n" +
              ref.metrics_yaml + (ref.metrics_yaml.back() == '\n' ? "" : "\n") + "```\n";
     }

@@ -30,6 +30,9 @@ struct RunResult {
   std::vector<std::string> characters;                ///< in evaluation order
   std::map<std::string, std::vector<double>> values;  ///< metric → per-character values
   std::string metrics_yaml;  ///< the run config's `metrics:` section (YAML), to state thresholds
+  /// A task's own statement of what its values are (eval_<part>.json `metric_definitions`;
+  /// the corrective task's errors have no `metrics:` section), stated under the table instead.
+  std::string metric_definitions;
 };
 
 /// Reads `<dir>/eval_<part>.json` and the `metrics` section of `<dir>/config.yaml`. Throws

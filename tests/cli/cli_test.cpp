@@ -417,9 +417,68 @@ TEST(Cli, DenseGatsSmokeSweepOnTheBundledBipeds) {
                                       "densegats_smoke_table3" / "best.pt"));
   EXPECT_FALSE(std::filesystem::exists(std::filesystem::path(results) / "densegats_lbs" /
                                        "densegats_smoke_table3" / "best.pt"));
+  EXPECT_NE(table.find("Metrics (the first run's evaluation): a vertex's error is its distance "
+                       "to the Delta Mush target"),
+            std::string::npos)
+      << table;
   // A corrective config without a model or baseline cannot be evaluated, and says why.
   const Result e = run("eval configs/densegats/task.yaml data.file=" + data);
   EXPECT_NE(e.status, 0);
+
+  // The error-colour figure (Fig. 10): ground truth, LBS, DQS and the network side by side.
+  const std::filesystem::path lbs = std::filesystem::path(results) / "densegats_lbs" /
+                                    "densegats_smoke_table3",
+                              dqs = std::filesystem::path(results) / "densegats_dqs" /
+                                    "densegats_smoke_table3",
+                              net = std::filesystem::path(results) / "densegats_smoke" /
+                                    "densegats_smoke_table3";
+  const std::filesystem::path figures = dir / "figures";
+  const Result f = run("figure " + lbs.string() + " " + dqs.string() + " " + net.string() +
+                       " --poses 2 --out " + figures.string());
+  ASSERT_EQ(f.status, 0) << f.err;
+  const std::string caption = read_file(figures / "README.md");
+  const std::string test_character = nlohmann::json::parse(read_file(net / "eval_test.json"))
+                                         ["per_character"][0]["character"];
+  std::size_t pngs = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(figures)) {
+    if (entry.path().extension() != ".png") continue;
+    ++pngs;
+    EXPECT_EQ(entry.path().filename().string().rfind(test_character + "_pose", 0), 0u)
+        << entry.path();
+    EXPECT_NE(caption.find("(" + entry.path().filename().string() + ")"), std::string::npos);
+    for (const auto& experiment : {"densegats_lbs", "densegats_dqs", "densegats_smoke"}) {
+      EXPECT_TRUE(std::filesystem::exists(figures / experiment /
+                                          entry.path().filename().replace_extension(".ply")))
+          << experiment << " " << entry.path();
+    }
+  }
+  EXPECT_EQ(pngs, 2u) << caption;
+  EXPECT_NE(caption.find("`densegats_dqs` (dqs, "), std::string::npos) << caption;
+  // A run evaluated without predictions has nothing to draw, and the message says what to run.
+  std::filesystem::remove_all(dqs / "predictions");
+  const Result nf = run("figure " + lbs.string() + " " + dqs.string() + " --out " +
+                        (dir / "figures2").string());
+  EXPECT_NE(nf.status, 0);
+  EXPECT_NE(nf.err.find("no saved predictions for part 'test'"), std::string::npos) << nf.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "figures2" / "README.md"));
+
+  // A committed run keeps its evaluation but not its checkpoints: the sweep uses the saved
+  // evaluation instead of training it again; without that either, it refuses to retrain.
+  for (const char* pt : {"best.pt", "last.pt"}) std::filesystem::remove(net / pt);
+  const std::string before = read_file(net / "metrics.jsonl");
+  const Result again = run("sweep " + (dir / "sweep.yaml").string());
+  ASSERT_EQ(again.status, 0) << again.err;
+  EXPECT_NE(again.out.find("saved evaluation; no checkpoint to resume"), std::string::npos)
+      << again.out;
+  EXPECT_EQ(read_file(net / "metrics.jsonl"), before);
+  std::filesystem::remove(net / "eval_test.json");
+  const Result gone = run("sweep " + (dir / "sweep.yaml").string());
+  EXPECT_NE(gone.status, 0);
+  EXPECT_NE(gone.err.find("has trained epochs (metrics.jsonl) but neither last.pt nor "
+                          "eval_test.json"),
+            std::string::npos)
+      << gone.err;
+  EXPECT_EQ(read_file(net / "metrics.jsonl"), before);
 }
 
 }  // namespace
