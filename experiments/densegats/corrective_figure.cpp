@@ -65,22 +65,6 @@ std::vector<int> spaced(int n, int count) {
   return out;
 }
 
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  const auto k = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1));
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
-}
-
-/// Front view above side view of one mesh.
-report::Image views(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
-                    const std::vector<report::Rgb>& colours) {
-  report::RenderOptions front, side;
-  side.azimuth_degrees = 90;
-  return report::compose_column(
-      {report::render_mesh(V, F, colours, front), report::render_mesh(V, F, colours, side)}, 4);
-}
-
 }  // namespace
 
 bool is_corrective_run(const fs::path& run_dir) {
@@ -191,7 +175,7 @@ void write_corrective_figures(const std::vector<std::string>& run_dirs,
       }
       p.vmax = options.error_max_cm > 0
                    ? options.error_max_cm
-                   : report::nice_width(std::max(percentile(all, 0.99), 1e-3), 1);
+                   : report::nice_width(std::max(report::quantile(all, 0.99), 1e-3), 1);
       panels.push_back(std::move(p));
     }
   }
@@ -216,7 +200,7 @@ void write_corrective_figures(const std::vector<std::string>& run_dirs,
     const PoseRef ref = p.ch->poses[static_cast<std::size_t>(p.pose)];
     const PooledClip& clip = data.clips()[static_cast<std::size_t>(ref.clip)];
     std::vector<report::Image> columns{
-        views(p.target, p.ch->mesh.F,
+        report::front_and_side(p.target, p.ch->mesh.F,
               std::vector<report::Rgb>(static_cast<std::size_t>(p.target.rows()), kTruthGrey))};
     readme += fmt::format("## {}, pose {} (clip `{}`, frame {})\n\n![{}]({}.png)\n\nScale 0 – {} "
                           "cm. Mean / max error (cm):",
@@ -224,7 +208,7 @@ void write_corrective_figures(const std::vector<std::string>& run_dirs,
     for (std::size_t i = 0; i < runs.size(); ++i) {
       const std::vector<double>& e = p.errors[i];
       const std::vector<report::Rgb> colours = report::colour_values(e, p.vmax);
-      columns.push_back(views(p.meshes[i], p.ch->mesh.F, colours));
+      columns.push_back(report::front_and_side(p.meshes[i], p.ch->mesh.F, colours));
       fs::create_directories(options.out / runs[i].experiment);
       report::write_coloured_ply(options.out / runs[i].experiment / (stem + ".ply"), p.meshes[i],
                                  p.ch->mesh.F, colours, "error_cm", e,

@@ -82,13 +82,6 @@ FigureRun open_run(const std::string& dir, const std::string& part) {
   return r;
 }
 
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  const auto k = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1));
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
-}
-
 /// One kind of map of a character: file suffix, PLY property, decimals of the means in the
 /// README, colour-scale top, values (one vector per run) and caption (`{}`: the scale top).
 struct ErrorMap {
@@ -104,12 +97,7 @@ report::Image panel(const data::PreparedCharacter& c,
                     const std::vector<std::vector<double>>& values, double vmax) {
   std::vector<report::Image> columns;
   for (const auto& v : values) {
-    const auto colours = report::colour_values(v, vmax);
-    report::RenderOptions front, side;
-    side.azimuth_degrees = 90;
-    columns.push_back(report::compose_column({report::render_mesh(c.V, c.F, colours, front),
-                                              report::render_mesh(c.V, c.F, colours, side)},
-                                             4));
+    columns.push_back(report::front_and_side(c.V, c.F, report::colour_values(v, vmax)));
   }
   const int decimals = vmax >= 1 ? 1 : static_cast<int>(std::ceil(-std::log10(vmax))) + 1;
   const report::Image bar = report::colour_bar(240, 14, vmax, decimals);
@@ -228,7 +216,7 @@ Command add_figure(CLI::App& app) {
           std::vector<double> all;
           for (const auto& d : deformation) all.insert(all.end(), d.begin(), d.end());
           const double deformation_max =
-              report::nice_width(std::max(percentile(all, 0.99), 1e-6), 1);
+              report::nice_width(std::max(report::quantile(all, 0.99), 1e-6), 1);
           const std::vector<ErrorMap> maps = {
               {"l1", "l1_error", 4, args->l1_max, &l1,
                "per-vertex L1 error Σ_b |P − G| of the pruned predicted bone weights against the "

@@ -158,6 +158,20 @@ Image compose_row(const std::vector<Image>& images, int gap, const Image* below)
   return out;
 }
 
+Image front_and_side(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                     const std::vector<Rgb>& colours) {
+  RenderOptions front, side;
+  side.azimuth_degrees = 90;
+  return compose_column({render_mesh(V, F, colours, front), render_mesh(V, F, colours, side)}, 4);
+}
+
+double quantile(std::vector<double> values, double q) {
+  if (values.empty()) return 0;
+  const auto k = static_cast<std::size_t>(q * static_cast<double>(values.size() - 1));
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+  return values[k];
+}
+
 Image compose_column(const std::vector<Image>& rows, int gap) {
   int width = 0, height = 0;
   for (const Image& im : rows) {

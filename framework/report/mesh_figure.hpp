@@ -40,6 +40,15 @@ struct RenderOptions {
 Image render_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                   const std::vector<Rgb>& colours, const RenderOptions& options = {});
 
+/// The front view (azimuth 0) above the side view (azimuth 90) of one coloured mesh, 4 pixels
+/// apart: one column of an error-map figure.
+Image front_and_side(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                     const std::vector<Rgb>& colours);
+
+/// The value at quantile q ∈ [0, 1] of `values` (the element at rank ⌊q·(n−1)⌋; 0 when empty):
+/// an error map's scale top that a few outliers do not set.
+double quantile(std::vector<double> values, double q);
+
 /// A horizontal viridis bar `width`×`height` pixels (plus tick labels below it) labelled at 0,
 /// vmax/2 and vmax with `decimals` digits after the point.
 Image colour_bar(int width, int height, double vmax, int decimals);

@@ -116,6 +116,15 @@ TEST(Compose, SizesAndPlacement) {
   EXPECT_EQ(pixel(cb, 99, 9), viridis(1));
 }
 
+TEST(Quantile, RankOfTheSortedValuesAndEmpty) {
+  const std::vector<double> v = {5, 1, 4, 2, 3, 100, 6, 7, 8, 9, 10};  // 11 values, one outlier
+  EXPECT_EQ(quantile(v, 0.0), 1);
+  EXPECT_EQ(quantile(v, 0.5), 6);    // rank 5 of 0..10
+  EXPECT_EQ(quantile(v, 0.95), 10);  // rank ⌊9.5⌋ = 9: the outlier does not set it
+  EXPECT_EQ(quantile(v, 1.0), 100);
+  EXPECT_EQ(quantile({}, 0.99), 0);
+}
+
 TEST(Ply, HeaderRowsAndValues) {
   testing::TempDir dir;
   Eigen::MatrixXd V(3, 3);
