@@ -11,6 +11,7 @@
 
 #include <cmath>
 
+#include "framework/geometry/acap.hpp"
 #include "framework/geometry/geodesic_neighbours.hpp"
 #include "framework/geometry/laplacian.hpp"
 #include "framework/geometry/merge_vertices.hpp"
@@ -113,6 +114,44 @@ void BM_Laplacian(benchmark::State& state, LaplacianKind kind) {
   set_counters(state, mesh.num_vertices());
 }
 
+/// ACAP features (mesh-sequence BiLSTM Sec. 3.1): the encoder's set-up (weights, Gram matrices,
+/// the Poisson factorisation), encoding one frame (a twist of the torus) and decoding it.
+Mesh twisted(const Mesh& m) {
+  Mesh out = m;
+  for (int i = 0; i < m.num_vertices(); ++i) {
+    const double a = 2.0 * m.V(i, 0);
+    const double y = m.V(i, 1), z = m.V(i, 2);
+    out.V(i, 1) = std::cos(a) * y - std::sin(a) * z;
+    out.V(i, 2) = std::sin(a) * y + std::cos(a) * z;
+  }
+  return out;
+}
+void BM_AcapSetUp(benchmark::State& state) {
+  const Mesh mesh = torus(static_cast<int>(state.range(0)), static_cast<int>(state.range(0)));
+  for (auto _ : state) {
+    const AcapEncoder acap(mesh, "torus");
+    benchmark::DoNotOptimize(acap.num_parts());
+  }
+  set_counters(state, mesh.num_vertices());
+}
+void BM_AcapEncode(benchmark::State& state) {
+  const Mesh mesh = torus(static_cast<int>(state.range(0)), static_cast<int>(state.range(0)));
+  const AcapEncoder acap(mesh, "torus");
+  const Eigen::MatrixXd frame = twisted(mesh).V;
+  for (auto _ : state) benchmark::DoNotOptimize(acap.encode_sequence({frame}).front().data());
+  set_counters(state, mesh.num_vertices());
+}
+void BM_AcapDecode(benchmark::State& state) {
+  const Mesh mesh = torus(static_cast<int>(state.range(0)), static_cast<int>(state.range(0)));
+  const AcapEncoder acap(mesh, "torus");
+  const Eigen::MatrixXd features = acap.encode(twisted(mesh).V);
+  for (auto _ : state) benchmark::DoNotOptimize(acap.decode(features).data());
+  set_counters(state, mesh.num_vertices());
+}
+
+BENCHMARK(BM_AcapSetUp)->Arg(32)->Arg(55)->Arg(71)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_AcapEncode)->Arg(32)->Arg(55)->Arg(71)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_AcapDecode)->Arg(32)->Arg(55)->Arg(71)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MergeVertices)->Arg(32)->Arg(55)->Arg(71)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Subdivide)->Arg(32)->Arg(55)->Arg(71)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_OneRing)->Arg(32)->Arg(55)->Arg(71)->Unit(benchmark::kMicrosecond);

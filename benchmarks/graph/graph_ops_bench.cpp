@@ -140,6 +140,15 @@ void BM_GconvPool(benchmark::State& s) {
 void BM_GatBlock(benchmark::State& s) {
   run(s, "{type: gat_block, heads: 8, hidden: 8, beta: 0.125}", s.range(0), kBoneWidth);
 }
+/// The mesh-sequence BiLSTM's mesh convolution (Eq. 2) and its transpose at the paper's feature
+/// width of 9 (ACAP) and a hidden width.
+void BM_MeanConv(benchmark::State& s) {
+  run(s, "{type: mean_conv, width: " + std::to_string(s.range(0)) + "}", s.range(0), kBoneWidth);
+}
+void BM_MeanConvTranspose(benchmark::State& s) {
+  run(s, "{type: mean_conv, transpose: true, width: " + std::to_string(s.range(0)) + "}",
+      s.range(0), kBoneWidth);
+}
 void BM_GlobalPool(benchmark::State& s) {
   run(s, "{type: global_pool, vertex_mlp: [512], bone_mlp: [512]}", s.range(0), kBoneWidth);
 }
@@ -201,6 +210,14 @@ SKINLAB_GRAPH_BENCH(BM_GconvPool);
 SKINLAB_GRAPH_BENCH(BM_GlobalPool);
 BENCHMARK(BM_GatBlock)
     ->ArgsProduct({{72}, {0, 1}})
+    ->ArgNames({"width", "backward"})
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MeanConv)
+    ->ArgsProduct({{9, 64}, {0, 1}})
+    ->ArgNames({"width", "backward"})
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MeanConvTranspose)
+    ->ArgsProduct({{9, 64}, {0, 1}})
     ->ArgNames({"width", "backward"})
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DropEdges)->Unit(benchmark::kMicrosecond);

@@ -16,21 +16,6 @@ namespace skinlab::densegats {
 
 namespace {
 
-/// 12 floats [R | t] row-major → a rigid transform; the rotation is re-orthonormalised (float32
-/// storage leaves it orthogonal to ~1e-7 only, and dual quaternion skinning checks rigidity).
-Eigen::Isometry3d rigid_from(const float* m) {
-  Eigen::Matrix3d r;
-  Eigen::Vector3d t;
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) r(i, j) = m[4 * i + j];
-    t(i) = m[4 * i + 3];
-  }
-  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
-  out.linear() = Eigen::Quaterniond(r).normalized().toRotationMatrix();
-  out.translation() = t;
-  return out;
-}
-
 /// N⁻¹ · T · N for a similarity N (undoes the normalisation) as a rigid transform.
 Eigen::Isometry3d conjugate(const Eigen::Matrix4d& N, const Eigen::Matrix4d& N_inverse,
                             const Eigen::Isometry3d& T) {
@@ -117,7 +102,7 @@ CorrectiveData::CorrectiveData(const data::Dataset& dataset, const std::string& 
         frame.reserve(static_cast<std::size_t>(num_joints_));
         for (int j = 0; j < num_joints_; ++j) {
           const float* m = a.frames.data() + (static_cast<std::size_t>(f) * num_joints_ + j) * 12;
-          frame.push_back(conjugate(N, N_inverse, rigid_from(m)));
+          frame.push_back(conjugate(N, N_inverse, data::joint_transform(m)));
         }
         clip.frames.push_back(std::move(frame));
       }
@@ -165,7 +150,7 @@ CorrectiveData::CorrectiveData(const data::Dataset& dataset, const std::string& 
     out.root = static_cast<int>(std::find(c.parents.begin(), c.parents.end(), -1) - c.parents.begin());
     const data::AnimationData& own = c.animations.front();
     for (int j = 0; j < num_joints_; ++j) {
-      out.bind_inverse.push_back(rigid_from(own.bind.data() + static_cast<std::size_t>(j) * 12).inverse());
+      out.bind_inverse.push_back(data::joint_transform(own.bind.data() + static_cast<std::size_t>(j) * 12).inverse());
     }
     out.mush = std::make_shared<const geometry::DeltaMush>(out.mesh, options.delta_mush, c.name);
     out.one_ring = data::to_long(c.one_ring_edges);

@@ -306,6 +306,19 @@ void write_dataset(const std::filesystem::path& file, const Dataset& dataset, in
   w.commit();
 }
 
+Eigen::Isometry3d joint_transform(const float* m) {
+  Eigen::Matrix3d r;
+  Eigen::Vector3d t;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) r(i, j) = m[4 * i + j];
+    t(i) = m[4 * i + 3];
+  }
+  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  out.linear() = Eigen::Quaterniond(r).normalized().toRotationMatrix();
+  out.translation() = t;
+  return out;
+}
+
 Dataset read_dataset(const std::filesystem::path& file) {
   const H5Reader r(file);
   if (!r.has_attribute("/", "format_version")) {

@@ -10,6 +10,7 @@
 /// range and throws IoError naming the file and the dataset (HDF5 path) that is wrong.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <filesystem>
 #include <map>
@@ -47,6 +48,12 @@ struct AnimationData {
   /// #J × 12 float32: bind-pose global transforms, same layout.
   std::vector<float> bind;
 };
+
+/// One joint's transform of an AnimationData array (12 float32, [R | t] row-major: a frame's or
+/// the bind pose's entry of joint j starts at 12·j) as a rigid transform; the rotation is
+/// re-orthonormalised (float32 storage leaves it orthogonal to ~1e-7 only, and dual quaternion
+/// skinning and ACAP's polar decompositions expect a rotation).
+Eigen::Isometry3d joint_transform(const float* m);
 
 /// A character after preprocessing, everything in the normalised frame (Y up, 1 m tall).
 struct PreparedCharacter {

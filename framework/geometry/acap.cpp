@@ -1,6 +1,7 @@
 #include "framework/geometry/acap.hpp"
 
 #include <Eigen/Geometry>
+#include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
@@ -21,17 +22,32 @@ constexpr double kTwoPi = 2 * M_PI;
 constexpr double kPrior = 1e-9;
 
 /// Unit normals of `V` on the template's faces, each scaled by the vertex's mean one-ring edge
-/// length in `V`.
+/// length in `V`. Where the face normals cancel (a double-sided sheet: both windings share the
+/// vertices), the normal of the one-ring's best-fitting plane instead, its sign left open
+/// (`flat` marks those vertices; `AcapEncoder::fit` picks the sign).
 Eigen::MatrixXd scaled_normals(const Eigen::MatrixXi& F, const Eigen::MatrixXd& V,
-                               const std::vector<std::vector<std::pair<int, double>>>& ring) {
+                               const std::vector<std::vector<std::pair<int, double>>>& ring,
+                               std::vector<char>* flat = nullptr) {
   Mesh m;
   m.V = V;
   m.F = F;
   Eigen::MatrixXd N = vertex_normals(m);
+  if (flat) flat->assign(static_cast<std::size_t>(V.rows()), 0);
   for (Eigen::Index i = 0; i < V.rows(); ++i) {
+    const auto& r = ring[static_cast<std::size_t>(i)];
     double length = 0;
-    for (const auto& [j, c] : ring[static_cast<std::size_t>(i)]) length += (V.row(i) - V.row(j)).norm();
-    N.row(i) *= length / static_cast<double>(ring[static_cast<std::size_t>(i)].size());
+    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+    for (const auto& [j, c] : r) {
+      const Eigen::Vector3d e = (V.row(i) - V.row(j)).transpose();
+      length += e.norm();
+      scatter += e * e.transpose();
+    }
+    if (N.row(i).squaredNorm() < 0.5) {  // vertex_normals gives 0 where the normals cancel
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(scatter);
+      N.row(i) = eig.eigenvectors().col(0).transpose();
+      if (flat) (*flat)[static_cast<std::size_t>(i)] = 1;
+    }
+    N.row(i) *= length / static_cast<double>(r.size());
   }
   return N;
 }
@@ -110,7 +126,7 @@ AcapEncoder::AcapEncoder(const Mesh& reference, const std::string& source, AcapO
   }
 
   // Template quantities of the fit (Eq. 1 plus the normal term).
-  normals_ = scaled_normals(reference_.F, reference_.V, ring_);
+  normals_ = scaled_normals(reference_.F, reference_.V, ring_, &flat_);
   mean_weight_.resize(static_cast<std::size_t>(n));
   gram_inverse_.resize(static_cast<std::size_t>(n));
   prior_.resize(static_cast<std::size_t>(n));
@@ -207,9 +223,16 @@ Eigen::Matrix3d AcapEncoder::fit(int i, const Eigen::MatrixXd& deformed,
     const Eigen::Vector3d d = (deformed.row(i) - deformed.row(j)).transpose();
     M += c * d * e.transpose();
   }
-  M += mean_weight_[static_cast<std::size_t>(i)] * normals.row(i).transpose() * normals_.row(i);
   M += prior_[static_cast<std::size_t>(i)] * Eigen::Matrix3d::Identity();
-  return M * gram_inverse_[static_cast<std::size_t>(i)];
+  const Eigen::Matrix3d normal_term =
+      mean_weight_[static_cast<std::size_t>(i)] * normals.row(i).transpose() * normals_.row(i);
+  const Eigen::Matrix3d& inverse = gram_inverse_[static_cast<std::size_t>(i)];
+  const Eigen::Matrix3d T = (M + normal_term) * inverse;
+  if (!flat_[static_cast<std::size_t>(i)]) return T;
+  // A flat vertex's plane normals have no sign: take the one that keeps the orientation
+  // (a motion's deformation gradient has a positive determinant).
+  const Eigen::Matrix3d flipped = (M - normal_term) * inverse;
+  return T.determinant() >= flipped.determinant() ? T : flipped;
 }
 
 std::vector<Eigen::Matrix3d> AcapEncoder::deformation_gradients(const Eigen::MatrixXd& deformed) const {

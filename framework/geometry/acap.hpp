@@ -13,8 +13,10 @@
 ///     fit does not say where the normal goes; as Sumner and Popović's fourth vertex does for a
 ///     triangle, we add the vertex normal scaled by the one-ring's mean edge length as one more
 ///     "edge" with the one-ring's mean weight: n_i ℓ_i ↦ n'_i ℓ'_i. Rigid motions and uniform
-///     scalings are then recovered exactly. A prior μ |T − I|² with μ = 10⁻⁹ tr(Σ c e eᵀ + …)
-///     settles what is still open (a double-sided sheet, whose vertex normals cancel).
+///     scalings are then recovered exactly. Where the face normals cancel (a double-sided
+///     sheet, common in game meshes) the one-ring's best-fit plane normal is used, with the
+///     sign that keeps det T > 0. A prior μ |T − I|² with μ = 10⁻⁹ tr(Σ c e eᵀ + …) settles
+///     anything still open.
 ///  2. Polar decomposition T_i = R_i S_i (R_i a rotation, S_i symmetric; via the SVD).
 ///  3. R_i as a rotation vector r_i = θ_i ω_i. The same rotation is every (θ_i + 2πk) ω_i, k ∈ ℤ
 ///     (a negative multiplier is the opposite axis); ACAP picks, for every vertex, the
@@ -118,7 +120,8 @@ class AcapEncoder {
   /// One-ring of every vertex: neighbour and weight c_ij, sorted by neighbour.
   std::vector<std::vector<std::pair<int, double>>> ring_;
   std::vector<double> mean_weight_;                ///< c̄ per vertex, on the template
-  Eigen::MatrixXd normals_;                        ///< template's unit vertex normals
+  Eigen::MatrixXd normals_;                        ///< template's length-scaled vertex normals
+  std::vector<char> flat_;                         ///< template normal from the one-ring plane
   std::vector<Eigen::Matrix3d> gram_inverse_;      ///< (Σ c e eᵀ + c̄ ℓ² n nᵀ + μ I)⁻¹ per vertex
   std::vector<double> prior_;                      ///< μ per vertex
   std::vector<int> part_;

@@ -104,7 +104,8 @@ TEST(Registry, ExactKeysOfEveryCategory) {
   const std::map<std::string, std::vector<std::string>> expected = {
       {"distance", {"euclidean", "hollow_dist", "volumetric_geodesic"}},
       {"graph_op",
-       {"b2v", "edge_conv", "gat_block", "gconv_pool", "global_pool", "mesh_conv", "v2b"}},
+       {"b2v", "edge_conv", "gat_block", "gconv_pool", "global_pool", "mean_conv", "mesh_conv",
+        "v2b"}},
       {"model", {"heterskinnet", "neuroskinning", "rignet_skin"}},
       {"corrective_model", {"densegats", "neuroskinning"}},
       {"loss", {"kl", "laplacian_smoothing", "mse", "soft_cross_entropy"}},

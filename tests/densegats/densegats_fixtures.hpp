@@ -10,7 +10,7 @@
 #include "experiments/densegats/corrective_data.hpp"
 #include "framework/core/config.hpp"
 #include "framework/data/dataset_file.hpp"
-#include "framework/data/prepare.hpp"
+#include "tests/bundled_dataset.hpp"
 #include "tests/test_util.hpp"
 
 namespace skinlab::densegats {
@@ -21,17 +21,8 @@ class BundledBipeds : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = new skinlab::testing::TempDir();
     file_ = (*dir_ / "bipeds.h5").string();
-    const std::string source = std::string(SKINLAB_SOURCE_DIR);
-    data::PrepareOptions quiet;
-    quiet.threads = 2;
-    quiet.progress = false;
-    data::prepare_dataset(
-        data::PrepareConfig::from(config::Config::load(
-            source + "/configs/datasets/zeroad_bipeds_bundled.yaml",
-            {"output=" + file_,
-             "sources=[{type: zeroad, path: " + source + "/datasets/zeroad/bundled}]"})),
-        quiet);
-    dataset_ = new data::Dataset(data::read_dataset(file_));
+    dataset_ = new data::Dataset(
+        skinlab::testing::prepare_bundled("configs/datasets/zeroad_bipeds_bundled.yaml", file_));
   }
   static void TearDownTestSuite() {
     delete dataset_;

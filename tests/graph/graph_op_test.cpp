@@ -262,7 +262,7 @@ TEST(Sequence, ConfigErrorsNameTheEntry) {
   expect_error<RegistryError>(
       [&] { Sequence::from(root["a"]); },
       {"test.yaml:3: a[1]", "unknown graph_op type 'spectral_conv'",
-       "b2v, edge_conv, gat_block, gconv_pool, global_pool, mesh_conv, v2b"});
+       "b2v, edge_conv, gat_block, gconv_pool, global_pool, mean_conv, mesh_conv, v2b"});
   expect_error<ConfigError>(
       [&] { Sequence::from(root["b"]); },
       {"test.yaml:5", "unknown field of graph_op 'edge_conv'", "did you mean 'self_loops'?"});
@@ -302,6 +302,7 @@ const std::map<std::string, std::string>& op_configs() {
       {"global_pool", "{type: global_pool, vertex_mlp: [3], bone_mlp: [2], to: [vertex, bone]}"},
       {"gconv_pool", "{type: gconv_pool, mlp: [4, 3]}"},
       {"gat_block", "{type: gat_block, heads: 2, hidden: 2, beta: 0.5}"},
+      {"mean_conv", "{type: mean_conv, width: 3, transpose: true}"},
   };
   return configs;
 }
@@ -375,7 +376,7 @@ TEST_P(EveryOp, LifeCycleAndFeatureErrors) {
 
 INSTANTIATE_TEST_SUITE_P(GraphOps, EveryOp,
                          ::testing::Values("b2v", "edge_conv", "gat_block", "global_pool",
-                                           "mesh_conv", "v2b"),
+                                           "mean_conv", "mesh_conv", "v2b"),
                          [](const auto& info) { return info.param; });
 
 }  // namespace

@@ -1,0 +1,30 @@
+#pragma once
+// Prepares a dataset config on the bundled real 0 A.D. subset (datasets/zeroad/bundled) for
+// tests: its output redirected, two threads, no progress output, extra overrides appended.
+
+#include <string>
+#include <vector>
+
+#include "framework/core/config.hpp"
+#include "framework/data/dataset_file.hpp"
+#include "framework/data/prepare.hpp"
+
+namespace skinlab::testing {
+
+/// `config` relative to the source tree (e.g. "configs/datasets/zeroad_bundled.yaml"),
+/// written to `output` and read back.
+inline data::Dataset prepare_bundled(const std::string& config, const std::string& output,
+                                     const std::vector<std::string>& extra = {}) {
+  const std::string source = std::string(SKINLAB_SOURCE_DIR);
+  std::vector<std::string> overrides = {
+      "output=" + output, "sources=[{type: zeroad, path: " + source + "/datasets/zeroad/bundled}]"};
+  overrides.insert(overrides.end(), extra.begin(), extra.end());
+  data::PrepareOptions quiet;
+  quiet.threads = 2;
+  quiet.progress = false;
+  data::prepare_dataset(
+      data::PrepareConfig::from(config::Config::load(source + "/" + config, overrides)), quiet);
+  return data::read_dataset(output);
+}
+
+}  // namespace skinlab::testing
