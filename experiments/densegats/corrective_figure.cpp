@@ -58,13 +58,6 @@ FigureRun open_run(const std::string& dir, const std::string& part) {
   return r;
 }
 
-/// `count` of the indices [0, n), evenly spaced (all when n <= count).
-std::vector<int> spaced(int n, int count) {
-  std::vector<int> out;
-  for (int k = 0; k < std::min(n, count); ++k) out.push_back(n <= count ? k : k * n / count);
-  return out;
-}
-
 }  // namespace
 
 bool is_corrective_run(const fs::path& run_dir) {
@@ -120,6 +113,7 @@ void write_corrective_figures(const std::vector<std::string>& run_dirs,
     const auto V = static_cast<Eigen::Index>(it->num_vertices());
     const std::string group = "/characters/" + name;
     std::vector<int> poses;
+    std::vector<data::RowMatrixXf> corrections, errors;  // per run, every saved pose
     for (const FigureRun& r : runs) {
       if (!r.predictions->has(group + "/poses")) {
         throw IoError(fmt::format("{}: character '{}' has no predictions for part '{}'",
@@ -132,8 +126,20 @@ void write_corrective_figures(const std::vector<std::string>& run_dirs,
                                   "(corrective.eval_poses or frame_stride differ)",
                                   r.dir.string(), name, runs.front().dir.string()));
       }
+      corrections.push_back(r.predictions->read_float(group + "/correction_cm"));
+      errors.push_back(r.predictions->read_float(group + "/error_cm"));
+      if (corrections.back().rows() != V * static_cast<Eigen::Index>(poses.size()) ||
+          corrections.back().cols() != 3 ||
+          errors.back().rows() != static_cast<Eigen::Index>(poses.size()) ||
+          errors.back().cols() != V) {
+        throw IoError(fmt::format("{}: character '{}' has {}×{} corrections and {}×{} errors; "
+                                  "{} poses of {} vertices expected",
+                                  r.dir.string(), name, corrections.back().rows(),
+                                  corrections.back().cols(), errors.back().rows(),
+                                  errors.back().cols(), poses.size(), V));
+      }
     }
-    for (int k : spaced(static_cast<int>(poses.size()), options.poses)) {
+    for (int k : evenly_spaced(poses.size(), options.poses)) {
       const int pose = poses[static_cast<std::size_t>(k)];
       if (pose < 0 || pose >= static_cast<int>(it->poses.size())) {
         throw IoError(fmt::format("{}: character '{}' pose {} is not in the dataset's pose list "
@@ -147,22 +153,13 @@ void write_corrective_figures(const std::vector<std::string>& run_dirs,
       p.ch = &*it;
       p.target = s.target;
       std::vector<double> all;
-      for (const FigureRun& r : runs) {
-        const data::RowMatrixXf corrections = r.predictions->read_float(group + "/correction_cm");
-        const data::RowMatrixXf errors = r.predictions->read_float(group + "/error_cm");
-        if (corrections.rows() != V * static_cast<Eigen::Index>(poses.size()) ||
-            corrections.cols() != 3 || errors.rows() != static_cast<Eigen::Index>(poses.size()) ||
-            errors.cols() != V) {
-          throw IoError(fmt::format("{}: character '{}' has {}×{} corrections and {}×{} errors; "
-                                    "{} poses of {} vertices expected",
-                                    r.dir.string(), name, corrections.rows(), corrections.cols(),
-                                    errors.rows(), errors.cols(), poses.size(), V));
-        }
+      for (std::size_t i = 0; i < runs.size(); ++i) {
+        const FigureRun& r = runs[i];
         const Eigen::MatrixXd correction =
-            corrections.middleRows(static_cast<Eigen::Index>(k) * V, V).cast<double>();
+            corrections[i].middleRows(static_cast<Eigen::Index>(k) * V, V).cast<double>();
         const Eigen::VectorXd error = (correction - s.displacement).rowwise().norm();
         const double drift =
-            (error - errors.row(k).transpose().cast<double>()).cwiseAbs().maxCoeff();
+            (error - errors[i].row(k).transpose().cast<double>()).cwiseAbs().maxCoeff();
         if (drift > kErrorTolerance) {
           throw IoError(fmt::format("{}: character '{}' pose {}: the saved errors differ from "
                                     "those rebuilt from {} by up to {:.3g} cm; the dataset or "

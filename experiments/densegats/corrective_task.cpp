@@ -61,8 +61,7 @@ graph::Graph mesh_graph(const CorrectiveCharacter& character) {
   return g;
 }
 
-std::vector<int> eval_pose_indices(const CorrectiveCharacter& character, int count) {
-  const std::size_t n = character.poses.size();
+std::vector<int> evenly_spaced(std::size_t n, int count) {
   std::vector<int> out;
   if (n <= static_cast<std::size_t>(count)) {
     for (std::size_t p = 0; p < n; ++p) out.push_back(static_cast<int>(p));
@@ -70,6 +69,10 @@ std::vector<int> eval_pose_indices(const CorrectiveCharacter& character, int cou
   }
   for (int k = 0; k < count; ++k) out.push_back(static_cast<int>(k * n / static_cast<std::size_t>(count)));
   return out;
+}
+
+std::vector<int> eval_pose_indices(const CorrectiveCharacter& character, int count) {
+  return evenly_spaced(character.poses.size(), count);
 }
 
 Window window_of(const CorrectiveSample& sample, const torch::Tensor& one_ring,

@@ -43,6 +43,9 @@ namespace skinlab::densegats {
 /// The one-ring graph of a character (vertex nodes only).
 graph::Graph mesh_graph(const CorrectiveCharacter& character);
 
+/// `count` of the indices [0, n), evenly spaced (k·n/count; all of them when n ≤ count).
+std::vector<int> evenly_spaced(std::size_t n, int count);
+
 /// `count` pose indices of `character`, evenly spaced over its pose list (all when it has fewer).
 std::vector<int> eval_pose_indices(const CorrectiveCharacter& character, int count);
 

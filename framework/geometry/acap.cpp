@@ -243,12 +243,18 @@ std::vector<Eigen::Matrix3d> AcapEncoder::deformation_gradients(const Eigen::Mat
   return T;
 }
 
-Eigen::RowVectorXd AcapEncoder::feature_of(const Eigen::Matrix3d& T,
-                                           const Eigen::Vector3d& reference) const {
-  Eigen::Matrix3d R, S;
-  polar_decompose(T, R, S);
+AcapEncoder::Polar AcapEncoder::polar_of(const Eigen::Matrix3d& T) {
+  Polar p;
+  Eigen::Matrix3d R;
+  polar_decompose(T, R, p.S);
   const Eigen::AngleAxisd aa(R);
-  const Eigen::Vector3d r = nearest_rotation_vector(aa.angle() * aa.axis(), reference);
+  p.r = aa.angle() * aa.axis();
+  return p;
+}
+
+Eigen::RowVectorXd AcapEncoder::feature_of(const Polar& p, const Eigen::Vector3d& reference) {
+  const Eigen::Vector3d r = nearest_rotation_vector(p.r, reference);
+  const Eigen::Matrix3d& S = p.S;
   Eigen::RowVectorXd q(kAcapWidth);
   q << r.x(), r.y(), r.z(), S(0, 0), S(0, 1), S(0, 2), S(1, 1), S(1, 2), S(2, 2);
   return q;
@@ -260,16 +266,13 @@ Eigen::MatrixXd AcapEncoder::encode(const Eigen::MatrixXd& deformed) const {
   Eigen::MatrixXd Q(n, kAcapWidth);
   // Breadth-first from the vertex of least rotation in each part; each vertex takes the
   // representative nearest to the mean of its neighbours assigned before it.
-  std::vector<double> angle(static_cast<std::size_t>(n));
-  for (int i = 0; i < n; ++i) {
-    Eigen::Matrix3d R, S;
-    polar_decompose(T[static_cast<std::size_t>(i)], R, S);
-    angle[static_cast<std::size_t>(i)] = Eigen::AngleAxisd(R).angle();
-  }
+  std::vector<Polar> polar;
+  polar.reserve(T.size());
+  for (const Eigen::Matrix3d& t : T) polar.push_back(polar_of(t));
   std::vector<int> order(static_cast<std::size_t>(n));
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
-    return angle[static_cast<std::size_t>(a)] < angle[static_cast<std::size_t>(b)];
+    return polar[static_cast<std::size_t>(a)].r.norm() < polar[static_cast<std::size_t>(b)].r.norm();
   });
   std::vector<char> done(static_cast<std::size_t>(n), 0);
   for (int seed : order) {
@@ -288,7 +291,7 @@ Eigen::MatrixXd AcapEncoder::encode(const Eigen::MatrixXd& deformed) const {
         }
       }
       if (assigned > 0) reference /= assigned;
-      Q.row(i) = feature_of(T[static_cast<std::size_t>(i)], reference);
+      Q.row(i) = feature_of(polar[static_cast<std::size_t>(i)], reference);
       done[static_cast<std::size_t>(i)] = 2;
       for (const auto& [j, c] : ring_[static_cast<std::size_t>(i)]) {
         if (!done[static_cast<std::size_t>(j)]) {
@@ -310,7 +313,7 @@ std::vector<Eigen::MatrixXd> AcapEncoder::encode_sequence(
     const std::vector<Eigen::Matrix3d> T = deformation_gradients(frame);
     Eigen::MatrixXd Q(num_vertices(), kAcapWidth);
     for (int i = 0; i < num_vertices(); ++i) {
-      Q.row(i) = feature_of(T[static_cast<std::size_t>(i)], previous.row(i).transpose());
+      Q.row(i) = feature_of(polar_of(T[static_cast<std::size_t>(i)]), previous.row(i).transpose());
     }
     previous = Q.leftCols(3);
     out.push_back(std::move(Q));

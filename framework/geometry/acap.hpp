@@ -111,7 +111,14 @@ class AcapEncoder {
 
  private:
   Eigen::Matrix3d fit(int i, const Eigen::MatrixXd& deformed, const Eigen::MatrixXd& normals) const;
-  Eigen::RowVectorXd feature_of(const Eigen::Matrix3d& T, const Eigen::Vector3d& reference) const;
+  /// T = exp([r]×) S with r the principal rotation vector (angle in [0, π]).
+  struct Polar {
+    Eigen::Vector3d r;
+    Eigen::Matrix3d S;
+  };
+  static Polar polar_of(const Eigen::Matrix3d& T);
+  /// The feature of one vertex: r's representative nearest `reference`, and S.
+  static Eigen::RowVectorXd feature_of(const Polar& p, const Eigen::Vector3d& reference);
   void check_frame(const Eigen::MatrixXd& X, int width, const char* what) const;
 
   Mesh reference_;
