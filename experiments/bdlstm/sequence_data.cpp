@@ -12,10 +12,10 @@
 
 namespace skinlab::bdlstm {
 
-SequenceOptions SequenceOptions::from(const config::Node& node) {
+SequenceOptions SequenceOptions::from(const config::Node& node, std::vector<std::string> other_keys) {
   SequenceOptions o;
   if (!node.exists() || node.is_null()) return o;
-  config::Fields f(node, "sequences", {});
+  config::Fields f(node, "sequences", std::move(other_keys));
   f.optional("characters", o.characters);
   f.optional("frame_stride", o.frame_stride).check(o.frame_stride >= 1, "frame_stride", "must be ≥ 1");
   f.optional("min_frames", o.min_frames).check(o.min_frames >= 2, "min_frames", "must be ≥ 2");

@@ -58,7 +58,8 @@ struct SequenceOptions {
   double test_fraction = 0.2;
   std::uint64_t seed = 0;
   /// Decodes and checks the section (every field optional); errors name the file, line, key.
-  static SequenceOptions from(const config::Node& node);
+  /// `other_keys` are accepted and left to the caller (the task's own keys, sequence_task.hpp).
+  static SequenceOptions from(const config::Node& node, std::vector<std::string> other_keys = {});
 };
 
 /// One clip on one mesh.

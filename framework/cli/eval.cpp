@@ -44,6 +44,11 @@ RunDir create_binder_run(EvalArgs& args) {
                 args.run + "`, then `skinlab eval <its run directory>`");
   }
   if (!untrained_method(config, o)) {
+    if (o.task == "sequence" || o.task == "corrective") {
+      throw ConfigError(args.run + ": a " + o.task + " config needs a 'model' (trained first) or a '" +
+                        (o.task == "sequence" ? "sequences" : "corrective") +
+                        ".baseline' to evaluate");
+    }
     o.require_binder_sections(config);  // names what an evaluated config needs
   }
   args.options.overrides.clear();

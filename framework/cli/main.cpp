@@ -15,6 +15,7 @@
 #include "framework/core/error.hpp"
 #include "framework/core/logging.hpp"
 #include "framework/core/registry.hpp"
+#include "experiments/bdlstm/sequence_task.hpp"
 #include "experiments/densegats/corrective_task.hpp"
 #include "framework/cli/commands.hpp"
 #include "framework/train/run_options.hpp"
@@ -80,10 +81,10 @@ Command add_config(CLI::App& app) {
   cmd->add_option("overrides", *overrides, "key.sub=value assignments, applied in order");
   return {cmd, [file, overrides] {
             const config::Config config = config::Config::load(*file, *overrides);
-            // Validates every section before printing (the corrective task's own section too).
-            if (train::RunOptions::from(config).task == "corrective") {
-              densegats::CorrectiveConfig::from(config);
-            }
+            // Validates every section before printing (the tasks' own sections too).
+            const std::string task = train::RunOptions::from(config).task;
+            if (task == "corrective") densegats::CorrectiveConfig::from(config);
+            if (task == "sequence") bdlstm::SequenceConfig::from(config);
             std::cout << config.to_yaml();
             return 0;
           }};

@@ -209,12 +209,12 @@ Command add_sweep(CLI::App& app) {
             t.metrics = sweep.metrics;
             t.title = sweep.title;
             t.command = "skinlab sweep " + args->file;
-            const std::string md = report::make_table(results, t);
+            const std::string md = table_text(results, t);
             t.format = "csv";
             const fs::path out = sweep.out;
             if (out.has_parent_path()) fs::create_directories(out.parent_path());
             write_file_atomic(out, md);
-            write_file_atomic(fs::path(out).replace_extension(".csv"), report::make_table(results, t));
+            write_file_atomic(fs::path(out).replace_extension(".csv"), table_text(results, t));
             std::cout << md << "wrote " << out.string() << "\n";
             return 0;
           }};

@@ -1,36 +1,54 @@
 #include "framework/cli/tasks.hpp"
 
+#include "experiments/bdlstm/sequence_table.hpp"
+
 namespace skinlab::cli {
 
 bool untrained_method(const config::Config& config, const train::RunOptions& options) {
   if (options.task == "corrective") {
     return !densegats::CorrectiveConfig::from(config).corrective.baseline.empty();
   }
+  if (options.task == "sequence") {
+    return !bdlstm::SequenceConfig::from(config).sequences.baseline.empty();
+  }
   if (options.binder.exists()) options.require_binder_sections(config);
   return options.binder.exists();
 }
 
 TaskTrainer::TaskTrainer(const config::Config& config) {
-  if (train::RunOptions::from(config).task == "corrective") {
+  const std::string task = train::RunOptions::from(config).task;
+  if (task == "corrective") {
     corrective_ = std::make_unique<densegats::CorrectiveTrainer>(config);
+  } else if (task == "sequence") {
+    sequence_ = std::make_unique<bdlstm::SequenceTrainer>(config);
   } else {
     skinning_ = std::make_unique<train::Trainer>(config);
   }
 }
 
 train::TrainResult TaskTrainer::fit(const RunDir& run, const train::FitLimits& limits) {
-  return corrective_ ? corrective_->fit(run, limits) : skinning_->fit(run, limits);
+  if (corrective_) return corrective_->fit(run, limits);
+  if (sequence_) return sequence_->fit(run, limits);
+  return skinning_->fit(run, limits);
 }
 
 bool TaskTrainer::validated() const {
-  return corrective_ ? corrective_->has_validation() : !skinning_->data().part("val").empty();
+  if (corrective_) return corrective_->has_validation();
+  if (sequence_) return false;  // the paper has no validation set; best.pt is by train loss
+  return !skinning_->data().part("val").empty();
 }
 
 eval::EvalReport evaluate_run(const RunDir& run, const eval::EvalOptions& options) {
   const config::Config config = config::Config::load(run.file("config.yaml"), options.overrides);
-  return train::RunOptions::from(config).task == "corrective"
-             ? densegats::evaluate_corrective(run, options)
-             : eval::evaluate(run, options);
+  const std::string task = train::RunOptions::from(config).task;
+  if (task == "corrective") return densegats::evaluate_corrective(run, options);
+  if (task == "sequence") return bdlstm::evaluate_sequence(run, options);
+  return eval::evaluate(run, options);
+}
+
+std::string table_text(const std::vector<report::RunResult>& runs, const report::TableOptions& options) {
+  if (!runs.empty() && runs.front().task == "sequence") return bdlstm::sequence_table(runs, options);
+  return report::make_table(runs, options);
 }
 
 }  // namespace skinlab::cli

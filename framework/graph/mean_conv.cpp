@@ -54,11 +54,24 @@ Features MeanConv::forward(const Features& in, const Graph& graph) {
       options_.transpose
           ? scatter_rows(x.index_select(0, receiver) * scale, neighbour, n, "sum")
           : scatter_rows(x.index_select(0, neighbour) * scale, receiver, n, "sum");
-  torch::Tensor y = self_->forward(x) + neighbours_->forward(aggregated);
-  if (options_.tanh) y = torch::tanh(y);
   Features out = in;
-  out.vertex = y;
+  out.vertex = combine(x, aggregated);
   return out;
+}
+
+torch::Tensor MeanConv::combine(const torch::Tensor& x, const torch::Tensor& aggregated) {
+  check_built();
+  const torch::Tensor y = self_->forward(x) + neighbours_->forward(aggregated);
+  return options_.tanh ? torch::tanh(y) : y;
+}
+
+torch::Tensor mean_operator(const torch::Tensor& edges, std::int64_t n, bool transpose) {
+  check_edges(edges, n, "one_ring", "vertices", "mean_operator");
+  const torch::Tensor receiver = edges.select(1, 0), neighbour = edges.select(1, 1);
+  const torch::Tensor degree = count_rows(receiver, n, torch::kFloat32);
+  const torch::Tensor values = degree.index_select(0, receiver).reciprocal();
+  const torch::Tensor index = transpose ? torch::stack({neighbour, receiver}) : torch::stack({receiver, neighbour});
+  return torch::sparse_coo_tensor(index, values, {n, n}).coalesce();
 }
 
 }  // namespace skinlab::graph

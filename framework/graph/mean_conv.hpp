@@ -38,6 +38,10 @@ class MeanConv final : public GraphOp {
 
   Features forward(const Features& in, const Graph& graph) override;
   std::string type() const override { return "mean_conv"; }
+  /// The layer from the input `x` (#rows×in) and its neighbour term `aggregated` (the same
+  /// shape: A x, or Aᵀ x when transposed), e.g. from `mean_operator`:
+  /// activation(W1 x + W2 aggregated + b).
+  torch::Tensor combine(const torch::Tensor& x, const torch::Tensor& aggregated);
   const Options& options() const { return options_; }
 
  protected:
@@ -47,5 +51,11 @@ class MeanConv final : public GraphOp {
   Options options_;
   torch::nn::Linear self_{nullptr}, neighbours_{nullptr};
 };
+
+/// The neighbour mean A of Eq. 2 over `edges` (#E×2 rows (i, j), i receiving from j) on `n`
+/// vertices as a sparse #n×n float32 COO tensor (A_ij = 1/d_i), or its transpose Aᵀ: for a fixed
+/// mesh, `torch::mm(A, X)` aggregates many feature columns at once (e.g. a batch of frames laid
+/// side by side, #V×(B·C)), which is what the mesh-sequence network does.
+torch::Tensor mean_operator(const torch::Tensor& edges, std::int64_t n, bool transpose);
 
 }  // namespace skinlab::graph

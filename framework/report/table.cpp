@@ -133,6 +133,7 @@ RunResult load_run_result(const fs::path& dir, const std::string& part) {
   try {
     const auto j = nlohmann::json::parse(read_file(file));
     r.label = j.at("experiment").get<std::string>();
+    r.task = j.value("task", std::string("skinning"));
     r.run_id = j.at("run").get<std::string>();
     r.dataset = j.at("dataset").get<std::string>();
     r.split = j.at("split").get<std::string>();

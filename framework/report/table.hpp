@@ -23,6 +23,7 @@ namespace skinlab::report {
 struct RunResult {
   std::filesystem::path dir;
   std::string label;       ///< the run's experiment name (e.g. heterskinnet_no_smoothing)
+  std::string task = "skinning";  ///< the eval report's task (skinning, corrective, sequence)
   std::string run_id;
   std::string dataset, split, part;
   std::string checkpoint;  ///< best, last, or none (a binder)

@@ -55,9 +55,11 @@ RunOptions RunOptions::from(const config::Config& config) {
   f.optional("results_dir", o.results_dir)
       .check(!o.results_dir.empty(), "results_dir", "must not be empty");
   f.optional("task", o.task)
-      .check(o.task == "skinning" || o.task == "corrective", "task",
-             "must be skinning (weights, the default) or corrective (DenseGATs)");
+      .check(o.task == "skinning" || o.task == "corrective" || o.task == "sequence", "task",
+             "must be skinning (weights, the default), corrective (DenseGATs) or sequence "
+             "(the mesh-sequence BiLSTM)");
   o.corrective = f.section("corrective");
+  o.sequences = f.section("sequences");
   o.model = f.section("model");
   o.binder = f.section("binder");
   o.losses = f.section("losses");
@@ -69,7 +71,11 @@ RunOptions RunOptions::from(const config::Config& config) {
   if (o.corrective.exists() && o.task != "corrective") {
     o.corrective.fail("a 'corrective' section belongs to a config with task: corrective");
   }
-  if (o.model.exists()) {
+  if (o.sequences.exists() && o.task != "sequence") {
+    o.sequences.fail("a 'sequences' section belongs to a config with task: sequence");
+  }
+  // A sequence model is validated by its task (experiments/bdlstm/sequence_task.hpp).
+  if (o.model.exists() && o.task != "sequence") {
     if (o.task == "corrective") {
       corrective_model_registry().create(o.model);
     } else {
@@ -115,6 +121,10 @@ void RunOptions::require_training_sections(const config::Config& config) const {
   if (binder.exists()) {
     throw ConfigError(config.source() + ": a 'binder' is not trained; evaluate it with "
                       "`skinlab eval " + config.source() + " --split test`");
+  }
+  if (task == "sequence") {  // its objective is sequences.objective (Eq. 3), not `losses:`
+    require_sections(config, "training", {{&model, "model: {type: bdlstm}"}, {&data_node, kDataExample}});
+    return;
   }
   require_sections(config, "training",
                    {{&model, "model: {type: ...}"},

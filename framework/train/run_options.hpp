@@ -7,7 +7,9 @@
 ///     experiment: heterskinnet        # results go to <results_dir>/<experiment>/<run_id>/
 ///     task: skinning                  # or corrective: DenseGATs' task (experiments/densegats),
 ///                                     # whose model is a `corrective_model` and which reads a
-///                                     # `corrective:` section (validated by that task)
+///                                     # `corrective:` section (validated by that task);
+///                                     # or sequence: the mesh-sequence BiLSTM
+///                                     # (experiments/bdlstm), with a `sequences:` section
 ///     description: ...                # free text, saved with the run
 ///     seed: 0                         # every random choice of the run derives from it
 ///     threads: 0                      # libtorch intra-op threads; 0 = every hardware thread
@@ -76,8 +78,9 @@ struct RunOptions {
   std::int64_t seed = 0;
   int threads = 0;
   std::string results_dir = "results";
-  std::string task = "skinning";  ///< skinning or corrective
+  std::string task = "skinning";  ///< skinning, corrective or sequence
   config::Node corrective;  ///< the corrective task's section (missing when absent)
+  config::Node sequences;   ///< the sequence task's section (missing when absent)
   config::Node model;    ///< missing when the config has no model section
   config::Node binder;   ///< missing when the config has no binder section
   config::Node losses;   ///< missing when the config has no losses section

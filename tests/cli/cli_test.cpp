@@ -481,5 +481,72 @@ TEST(Cli, DenseGatsSmokeSweepOnTheBundledBipeds) {
   EXPECT_EQ(read_file(net / "metrics.jsonl"), before);
 }
 
+// What CI runs of the mesh-sequence task (issue 10): the bundled sequences prepared, the smoke
+// sweep of configs/sweeps/bdlstm_smoke_tables.yaml (a tiny share-weight BiLSTM and its
+// unidirectional variant trained, ACAP extrapolation and the held frame evaluated) through the
+// binary, its Tables 1-2, and the errors of evaluating what cannot be evaluated.
+TEST(Cli, BdlstmSmokeSweepOnTheBundledWolf) {
+  TempDir dir;
+  const std::string data = (dir / "sequences.h5").string();
+  const std::filesystem::path results = dir / "results";
+  const Result p = run("prepare configs/datasets/zeroad_sequences_bundled.yaml output=" + data +
+                       " --threads 2");
+  ASSERT_EQ(p.status, 0) << p.err;
+  std::string sweep = read_file(std::filesystem::path(SKINLAB_SOURCE_DIR) / "configs" / "sweeps" /
+                                "bdlstm_smoke_tables.yaml");
+  const std::string out_line = "out: results/tables/bdlstm_smoke_tables.md";
+  ASSERT_NE(sweep.find(out_line), std::string::npos) << sweep;
+  const std::filesystem::path table_md = dir / "table.md";
+  sweep.replace(sweep.find(out_line), out_line.size(), "out: " + table_md.string());
+  const std::string data_line = "data.file=results/datasets/zeroad_sequences_bundled.h5";
+  ASSERT_NE(sweep.find(data_line), std::string::npos) << sweep;
+  sweep.replace(sweep.find(data_line), data_line.size(),
+                "data.file=" + data + ", results_dir=" + results.string());
+  const Result s = run("sweep " + dir.write("sweep.yaml", sweep).string());
+  ASSERT_EQ(s.status, 0) << s.err;
+
+  const std::string table = read_file(table_md);
+  for (const std::string row :
+       {"| bdlstm_smoke (1 IF) |", "| bdlstm_smoke (3 IF) |", "| bdlstm_smoke_unidirectional (1 IF) |",
+        "| bdlstm_acap_extrapolation (2 IF) |", "| bdlstm_hold (1 IF) |",
+        "| ACAP floor (true features decoded) |", "| method | wolf 1st | wolf 5th |"}) {
+    EXPECT_NE(table.find(row), std::string::npos) << row << "\n" << table;
+  }
+  const auto mean = [&](const std::string& experiment) {
+    const auto report = nlohmann::json::parse(
+        read_file(results / experiment / "bdlstm_smoke_tables" / "eval_test.json"));
+    EXPECT_EQ(report["task"], "sequence");
+    EXPECT_EQ(report["per_character"].size(), 1u);
+    return report["mean"];
+  };
+  const auto net = mean("bdlstm_smoke"), hold = mean("bdlstm_hold"),
+             extrapolation = mean("bdlstm_acap_extrapolation");
+  EXPECT_TRUE(std::filesystem::exists(results / "bdlstm_smoke" / "bdlstm_smoke_tables" / "best.pt"));
+  EXPECT_FALSE(std::filesystem::exists(results / "bdlstm_hold" / "bdlstm_smoke_tables" / "best.pt"));
+  // Every method is scored on the same predictions; the floor does not depend on the method.
+  EXPECT_EQ(net["starts5"], hold["starts5"]);
+  EXPECT_GT(net["starts5"].get<double>(), 0);
+  EXPECT_GE(net["starts1"].get<double>(), net["starts5"].get<double>());
+  EXPECT_EQ(net["floor5_mm"], extrapolation["floor5_mm"]);
+  // The wolf moves: 5 frames on, the held frame is further off than 1 frame on, and both are
+  // above what the representation itself loses.
+  EXPECT_GT(hold["e5_1if_mm"].get<double>(), hold["e1_1if_mm"].get<double>());
+  EXPECT_GT(hold["e1_1if_mm"].get<double>(), hold["floor1_mm"].get<double>());
+  for (const std::string key : {"e1_1if_mm", "e5_1if_mm", "e1_3if_mm", "e5_3if_mm"}) {
+    EXPECT_GT(net[key].get<double>(), 0) << key;
+  }
+  // Nothing to evaluate, a part that is not held out, a baseline to train: clear errors.
+  const Result e = run("eval configs/bdlstm/task.yaml experiment=none data.file=" + data);
+  EXPECT_NE(e.status, 0);
+  EXPECT_NE(e.err.find("'model' (trained first) or a 'sequences.baseline'"), std::string::npos) << e.err;
+  const Result part = run("eval " + (results / "bdlstm_hold" / "bdlstm_smoke_tables").string() +
+                          " --split train");
+  EXPECT_NE(part.status, 0);
+  EXPECT_NE(part.err.find("held-out windows"), std::string::npos) << part.err;
+  const Result t = run("train configs/bdlstm/hold.yaml data.file=" + data);
+  EXPECT_NE(t.status, 0);
+  EXPECT_NE(t.err.find("is not trained"), std::string::npos) << t.err;
+}
+
 }  // namespace
 }  // namespace skinlab

@@ -144,3 +144,33 @@ TEST(MeanConv, WidthsAndErrors) {
 
 }  // namespace
 }  // namespace skinlab::graph
+
+namespace skinlab::graph {
+namespace {
+
+using namespace skinlab::graph::testing;
+
+TEST(MeanConv, SparseOperatorMatchesTheOp) {
+  // mean_operator(edges) is the layer's A (Aᵀ): combine(x, A x) is forward(x), for the mean and
+  // its transpose, on the asymmetric geodesic set as well (edges given as the one-ring here).
+  const TinyGraph t = tiny_graph(3, 2, torch::kFloat32);
+  for (const torch::Tensor& edges : {t.graph.one_ring, t.graph.geodesic}) {
+    for (bool transpose : {false, true}) {
+      MeanConv::Options o;
+      o.width = 4;
+      o.transpose = transpose;
+      MeanConv op(o);
+      op.build(t.dims);
+      Graph g = t.graph;
+      g.one_ring = edges;
+      const torch::Tensor A = mean_operator(edges, g.num_vertices, transpose);
+      const torch::Tensor expected = op.forward(t.features, g).vertex;
+      const torch::Tensor got = op.combine(t.features.vertex, torch::mm(A, t.features.vertex));
+      EXPECT_TRUE(torch::allclose(got, expected, 1e-6, 1e-6)) << transpose;
+    }
+  }
+  EXPECT_THROW(mean_operator(edge_tensor({{0, 9}}), 8, false), c10::Error);
+}
+
+}  // namespace
+}  // namespace skinlab::graph

@@ -1,0 +1,151 @@
+#pragma once
+/// \file
+/// Training, evaluation and generation of the mesh-sequence task (`task: sequence`; Qiao et al.,
+/// "Synthesizing Mesh Deformation Sequences with Bidirectional LSTM"), on the sequences of
+/// sequence_data.hpp with the network of sequence_net.hpp.
+///
+///     task: sequence
+///     data: {file: results/datasets/zeroad_sequences.h5}
+///     sequences:                 # sequence_data.hpp's keys (characters, frame_stride, ...), and
+///       window: 32               # frames per training sequence (Sec. 4.1: 32)
+///       batch: 8                 # training sequences per iteration (Sec. 4.1: 8)
+///       iterations_per_epoch: 100
+///       objective: {recon: 1.0, bidir: 0.5, kl: 0.1, l2: 0.1}   # Eq. 3: α1 = 0.5, α2 = 0.1
+///       initial_frames: [1, 3]   # Table 1: Ours+1 IF, Ours+3 IF
+///       horizons: [5, 10, 15]    # Table 1: the 5th, 10th, 15th generated frame
+///       baseline: ""             # or acap_extrapolation ([24]) / hold, instead of a model
+///
+/// Features are scaled into [−0.95, 0.95] per (vertex, dimension) over the character's training
+/// frames (acap.hpp's FeatureScale); the network sees and predicts scaled features.
+///
+/// Training (Sec. 3.3-3.4, 4.1): each iteration draws `batch` windows of `window` consecutive
+/// training frames (never crossing a held-out window; shorter when no training stretch is that
+/// long), runs the forward chain from each window's first frame and the backward chain from its
+/// last, free-running, and minimises Eq. 3:
+///
+///     L = recon · L_recon + bidir · L_bidir + kl · L_KL + l2 · L_2
+///     L_recon = Σ_{i=2..L} ‖S^f_i − X_i‖ + ‖S^b_i − X_{L+1−i}‖                   (Eq. 4)
+///     L_bidir = Σ_{i=1..L} ‖S^f_i − S^b_{L+1−i}‖                                  (Eq. 5)
+///
+/// ‖·‖ is the Frobenius norm of a frame's #V×9 feature difference (the paper's norm, not
+/// squared), averaged over the batch; the i = 1 terms of Eq. 4 are the given frames and vanish.
+/// L_KL is the VAE term of Sec. 3.4, averaged over the encoded frames; L_2 = Σ w² over every
+/// trainable parameter. The paper's α2 = 0.1 weighs L_KL + L_2, so both weights are 0.1 here;
+/// "w/o L_KL" (Table 2) sets kl: 0. The unidirectional scheme has no backward chain, so no
+/// backward reconstruction and no L_bidir. Adam (`train.lr`, default Adam β; Sec. 4.1).
+/// An epoch is `iterations_per_epoch` iterations; the paper trains 7,000 iterations. There is
+/// no validation set (the paper has none): best.pt is the epoch of lowest training loss.
+///
+/// Evaluation (Table 1): only on the held-out windows (part `test`). Every start a of a window
+/// with the last initial frame l = a + 2 inside it gives up to three predictions of frame l + h
+/// for each horizon h with l + h inside the window:
+///  - the network with u ∈ `initial_frames` initial frames X_{l−u+1..l} (metric `e<h>_<u>if_mm`);
+///  - `acap_extrapolation`, [24]'s linear extrapolation in ACAP feature space from the two
+///    initial frames X_{l−1}, X_l: X_{l+h} = X_l + h (X_l − X_{l−1}) (`e<h>_2if_mm`);
+///  - `hold`: the last initial frame repeated, X_{l+h} = X_l (`e<h>_1if_mm`), the floor any
+///    motion model must beat;
+/// and the representation's own floor, the ground-truth features decoded (`floor<h>_mm`).
+/// Every method predicts the same frames. A prediction is decoded to positions (acap.hpp), each
+/// connected part placed at its ground-truth centroid (ACAP features carry no translation), and
+/// its error is the mean distance of its vertices to the ground truth, in mm in the character's
+/// 1 m-tall frame. A character's value is the mean over its predictions; `starts<h>` counts
+/// them.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "experiments/bdlstm/sequence_data.hpp"
+#include "experiments/bdlstm/sequence_net.hpp"
+#include "framework/core/config.hpp"
+#include "framework/core/run_dir.hpp"
+#include "framework/eval/evaluator.hpp"
+#include "framework/geometry/acap.hpp"
+#include "framework/train/run_data.hpp"
+#include "framework/train/run_options.hpp"
+#include "framework/train/trainer.hpp"
+
+namespace skinlab::bdlstm {
+
+/// The weights of Eq. 3's terms.
+struct Objective {
+  double recon = 1.0, bidir = 0.5, kl = 0.1, l2 = 0.1;
+};
+
+/// The `sequences:` section of a sequence config.
+struct SequenceTaskOptions {
+  SequenceOptions data;
+  int window = 32;
+  int batch = 8;
+  int iterations_per_epoch = 100;
+  Objective objective;
+  std::vector<int> initial_frames{1, 3};
+  std::vector<int> horizons{5, 10, 15};
+  std::string baseline;  ///< "", acap_extrapolation or hold
+  /// Errors name the file, line and key.
+  static SequenceTaskOptions from(const config::Node& node);
+};
+
+/// A validated sequence config.
+struct SequenceConfig {
+  train::RunOptions run;
+  SequenceTaskOptions sequences;
+  /// Throws ConfigError for anything invalid, including another task, a model that is not a
+  /// `bdlstm`, both a model and a baseline, and a model run over anything but one character
+  /// (the network is sized by its mesh).
+  static SequenceConfig from(const config::Config& config);
+};
+
+/// A character's sequences in the network's units: the scale fitted over its training frames.
+struct ScaledCharacter {
+  const SequenceCharacter* character = nullptr;
+  geometry::FeatureScale scale;
+  /// Every sequence's frames scaled, as float tensors #V×9.
+  std::vector<std::vector<torch::Tensor>> frames;
+};
+ScaledCharacter scale_character(const SequenceCharacter& character);
+
+/// The network of a config for `character` (libtorch seeded with the config's seed first).
+std::shared_ptr<SequenceNet> build_network(const SequenceConfig& config,
+                                           const SequenceCharacter& character);
+
+/// Eq. 3-5 on a rollout of `window` (L × [B×V×9]); fills `parts` (recon, bidir, kl, l2) when
+/// given.
+torch::Tensor sequence_loss(SequenceNet& net, const Rollout& rollout,
+                            const std::vector<torch::Tensor>& window, const Objective& objective,
+                            std::map<std::string, double>* parts = nullptr);
+
+class SequenceTrainer {
+ public:
+  /// Validates the config, reads the dataset, builds the character's sequences, the network and
+  /// Adam. Nothing is written.
+  explicit SequenceTrainer(const config::Config& config);
+  train::TrainResult fit(const RunDir& run, const train::FitLimits& limits = {});
+  SequenceNet& network() { return *net_; }
+  /// The training windows' (sequence, first frame) and their length.
+  const std::vector<std::pair<int, int>>& windows() const { return windows_; }
+  int window_length() const { return length_; }
+
+ private:
+  double iterate(at::Generator& rng, std::map<std::string, double>& parts);
+
+  SequenceConfig options_;
+  train::RunData run_data_;
+  std::unique_ptr<SequenceData> data_;
+  ScaledCharacter scaled_;
+  std::vector<std::pair<int, int>> windows_;
+  int length_ = 0;
+  std::shared_ptr<SequenceNet> net_;
+  std::unique_ptr<torch::optim::Adam> optimizer_;
+  torch::Tensor initial_torch_rng_;
+  bool fitted_ = false;
+};
+
+/// Evaluates a sequence run (its checkpoint, or its baseline) on the held-out windows; see the
+/// file comment. Throws as eval::evaluate, and Error for a part other than `test`.
+eval::EvalReport evaluate_sequence(const RunDir& run, const eval::EvalOptions& options);
+
+/// Whether `run`'s config.yaml says `task: sequence`.
+bool is_sequence_run(const std::filesystem::path& run);
+
+}  // namespace skinlab::bdlstm
