@@ -251,31 +251,12 @@ train::TrainResult SequenceTrainer::fit(const RunDir& run, const train::FitLimit
   at::Generator torch_rng = at::detail::getDefaultCPUGenerator();
   at::Generator order_rng =
       at::make_generator<at::CPUGeneratorImpl>(train::order_seed(options_.run.seed));
-  train::remove_stale_temporaries(run);
-  train::TrainingState state;
-  state.seed = options_.run.seed;
-  state.threads = torch_threads();
-  state.model_config = options_.run.model.to_yaml();
+  train::FitStart begun = train::start_fit(run, *net_, *optimizer_, options_.run.seed,
+                                           options_.run.model.to_yaml(), torch_rng, order_rng,
+                                           initial_torch_rng_);
+  train::TrainingState& state = begun.state;
+  result.resumed = begun.resumed;
   const fs::path last = run.file(train::kLastCheckpoint);
-  if (fs::exists(last)) {
-    const train::TrainingState saved = train::load_checkpoint(last, *net_, optimizer_.get());
-    if (saved.seed != options_.run.seed) {
-      throw Error(last.string() + ": checkpoint was trained with seed " +
-                  std::to_string(saved.seed) + ", the config says " +
-                  std::to_string(options_.run.seed));
-    }
-    state.epoch = saved.epoch;
-    state.best_epoch = saved.best_epoch;
-    state.best_loss = saved.best_loss;
-    train::set_rng_state(torch_rng, saved.torch_rng);
-    train::set_rng_state(order_rng, saved.order_rng);
-    result.resumed = true;
-    spdlog::info("resuming {} after epoch {} (best epoch {}, loss {:.6g})", run.path().string(),
-                 state.epoch, state.best_epoch, state.best_loss);
-  } else {
-    train::set_rng_state(torch_rng, initial_torch_rng_);
-  }
-  train::truncate_metrics(run, state.epoch);
   auto stopped_early = [&] {
     return t.patience > 0 && state.best_epoch > 0 && state.epoch - state.best_epoch >= t.patience;
   };

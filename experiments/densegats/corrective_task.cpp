@@ -203,37 +203,22 @@ train::TrainResult CorrectiveTrainer::fit(const RunDir& run, const train::FitLim
   at::Generator torch_rng = at::detail::getDefaultCPUGenerator();
   at::Generator order_rng =
       at::make_generator<at::CPUGeneratorImpl>(train::order_seed(options_.run.seed));
-  train::remove_stale_temporaries(run);
-  train::TrainingState state;
-  state.seed = options_.run.seed;
-  state.threads = torch_threads();
-  state.model_config = options_.run.model.to_yaml();
+  train::FitStart begun = train::start_fit(run, *model_, *optimizer_, options_.run.seed,
+                                           options_.run.model.to_yaml(), torch_rng, order_rng,
+                                           initial_torch_rng_);
+  train::TrainingState& state = begun.state;
+  result.resumed = begun.resumed;
+  const fs::path last = run.file(train::kLastCheckpoint);
   double lr = t.lr, plateau_best = std::numeric_limits<double>::infinity();
   int plateau_bad = 0;
-  const fs::path last = run.file(train::kLastCheckpoint);
-  if (fs::exists(last)) {
-    const train::TrainingState saved = train::load_checkpoint(last, *model_, optimizer_.get());
-    if (saved.seed != options_.run.seed) {
-      throw Error(last.string() + ": checkpoint was trained with seed " +
-                  std::to_string(saved.seed) + ", the config says " +
-                  std::to_string(options_.run.seed));
-    }
-    state.epoch = saved.epoch;
-    state.best_epoch = saved.best_epoch;
-    state.best_loss = saved.best_loss;
-    lr = saved.extra.count("lr") ? saved.extra.at("lr") : lr;
-    plateau_best = saved.extra.count("plateau_best") ? saved.extra.at("plateau_best") : plateau_best;
-    plateau_bad = saved.extra.count("plateau_bad") ? static_cast<int>(saved.extra.at("plateau_bad")) : 0;
+  if (begun.resumed) {
+    const auto& extra = begun.extra;
+    lr = extra.count("lr") ? extra.at("lr") : lr;
+    plateau_best = extra.count("plateau_best") ? extra.at("plateau_best") : plateau_best;
+    plateau_bad = extra.count("plateau_bad") ? static_cast<int>(extra.at("plateau_bad")) : 0;
     set_lr(*optimizer_, lr);
-    train::set_rng_state(torch_rng, saved.torch_rng);
-    train::set_rng_state(order_rng, saved.order_rng);
-    result.resumed = true;
-    spdlog::info("resuming {} after epoch {} (best epoch {}, loss {:.6g}, lr {:.3g})",
-                 run.path().string(), state.epoch, state.best_epoch, state.best_loss, lr);
-  } else {
-    train::set_rng_state(torch_rng, initial_torch_rng_);
+    spdlog::info("learning rate {:.3g} (plateau: best {:.6g}, {} bad epochs)", lr, plateau_best, plateau_bad);
   }
-  train::truncate_metrics(run, state.epoch);
   const bool have_val = !validation_.empty();
   if (!have_val) spdlog::warn("no validation character: best.pt and early stopping use the train loss");
   auto stopped_early = [&] {

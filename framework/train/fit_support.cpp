@@ -8,6 +8,8 @@
 #include <mutex>
 
 #include "framework/core/atomic_file.hpp"
+#include "framework/core/environment.hpp"
+#include "framework/core/error.hpp"
 #include "framework/train/trainer.hpp"
 
 namespace skinlab::train {
@@ -98,6 +100,43 @@ void finish_fit(TrainResult& result, const TrainingState& state, const TrainOpti
   result.best_epoch = static_cast<int>(state.best_epoch);
   result.best_loss = state.best_loss;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+FitStart start_fit(const RunDir& run, torch::nn::Module& model, torch::optim::Optimizer& optimizer,
+                   std::int64_t seed, const std::string& model_config, at::Generator& torch_rng,
+                   at::Generator& order_rng, const torch::Tensor& initial_torch_rng) {
+  remove_stale_temporaries(run);
+  FitStart start;
+  TrainingState& state = start.state;
+  state.seed = seed;
+  state.threads = torch_threads();
+  state.model_config = model_config;
+  const std::filesystem::path last = run.file(kLastCheckpoint);
+  if (std::filesystem::exists(last)) {
+    const TrainingState saved = load_checkpoint(last, model, &optimizer);
+    if (saved.seed != seed) {
+      throw Error(last.string() + ": checkpoint was trained with seed " +
+                  std::to_string(saved.seed) + ", the config says " + std::to_string(seed));
+    }
+    if (saved.threads != state.threads) {
+      spdlog::warn("{} was written with {} threads, resuming with {}: the result may differ in "
+                   "the last bits from an uninterrupted run",
+                   last.string(), saved.threads, state.threads);
+    }
+    state.epoch = saved.epoch;
+    state.best_epoch = saved.best_epoch;
+    state.best_loss = saved.best_loss;
+    start.extra = saved.extra;
+    set_rng_state(torch_rng, saved.torch_rng);
+    set_rng_state(order_rng, saved.order_rng);
+    start.resumed = true;
+    spdlog::info("resuming {} after epoch {} (best epoch {}, loss {:.6g})", run.path().string(),
+                 state.epoch, state.best_epoch, state.best_loss);
+  } else {
+    set_rng_state(torch_rng, initial_torch_rng);
+  }
+  truncate_metrics(run, state.epoch);
+  return start;
 }
 
 }  // namespace skinlab::train

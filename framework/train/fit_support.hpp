@@ -50,6 +50,22 @@ void truncate_metrics(const RunDir& run, std::int64_t epoch);
 /// or below best_loss − min_delta), best_epoch and best_loss. Returns whether it improved.
 bool record_epoch(TrainingState& state, std::int64_t epoch, double selection, double min_delta);
 
+/// How a fit starts (`start_fit`): the state to continue from, and whether it came from last.pt.
+struct FitStart {
+  TrainingState state;  ///< epoch and best counters restored; seed, threads, model config set
+  bool resumed = false;
+  std::map<std::string, double> extra;  ///< the checkpoint's task state (empty when starting)
+};
+
+/// The start of every fit in `run`: removes a killed process's temporaries; when `run` has
+/// last.pt, loads it into `model` and `optimizer` (Error for another seed than `seed`, a warning
+/// for another thread count), restores both generators and the epoch and best counters and logs
+/// it; otherwise resets `torch_rng` to `initial_torch_rng`. Then drops metrics.jsonl records past
+/// the restored epoch.
+FitStart start_fit(const RunDir& run, torch::nn::Module& model, torch::optim::Optimizer& optimizer,
+                   std::int64_t seed, const std::string& model_config, at::Generator& torch_rng,
+                   at::Generator& order_rng, const torch::Tensor& initial_torch_rng);
+
 /// The end of a fit: sets `result`'s early_stopped (logging it unless the fit was interrupted),
 /// epochs, best epoch and loss from the final `state`, and the wall time since `start`.
 void finish_fit(TrainResult& result, const TrainingState& state, const TrainOptions& options,

@@ -140,36 +140,11 @@ TrainResult Trainer::fit(const RunDir& run, const FitLimits& limits) {
   at::Generator torch_rng = at::detail::getDefaultCPUGenerator();
   at::Generator order_rng = at::make_generator<at::CPUGeneratorImpl>(order_seed(options_.seed));
 
-  remove_stale_temporaries(run);
-  TrainingState state;
-  state.seed = options_.seed;
-  state.threads = torch_threads();
-  state.model_config = options_.model.to_yaml();
+  FitStart begun = start_fit(run, *model_, *optimizer_, options_.seed, options_.model.to_yaml(),
+                             torch_rng, order_rng, initial_torch_rng_);
+  TrainingState& state = begun.state;
+  result.resumed = begun.resumed;
   const fs::path last = run.file(kLastCheckpoint);
-  if (fs::exists(last)) {
-    const TrainingState saved = load_checkpoint(last, *model_, optimizer_.get());
-    if (saved.seed != options_.seed) {
-      throw Error(last.string() + ": checkpoint was trained with seed " +
-                  std::to_string(saved.seed) + ", the config says " +
-                  std::to_string(options_.seed));
-    }
-    if (saved.threads != state.threads) {
-      spdlog::warn("{} was written with {} threads, resuming with {}: the result may differ in "
-                   "the last bits from an uninterrupted run",
-                   last.string(), saved.threads, state.threads);
-    }
-    state.epoch = saved.epoch;
-    state.best_epoch = saved.best_epoch;
-    state.best_loss = saved.best_loss;
-    set_rng_state(torch_rng, saved.torch_rng);
-    set_rng_state(order_rng, saved.order_rng);
-    result.resumed = true;
-    spdlog::info("resuming {} after epoch {} (best epoch {}, loss {:.6g})", run.path().string(),
-                 state.epoch, state.best_epoch, state.best_loss);
-  } else {
-    set_rng_state(torch_rng, initial_torch_rng_);
-  }
-  truncate_metrics(run, state.epoch);
 
   const std::vector<int>& train = data_.part("train");
   const bool have_val = !data_.part("val").empty();
