@@ -210,8 +210,7 @@ SequenceTrainer::SequenceTrainer(const config::Config& config)
   spdlog::info("sequence task: '{}' ({} vertices), {} clips, {} training windows of {} frames; "
                "{} network, {} parameters",
                ch.name, ch.num_vertices(), ch.sequences.size(), windows_.size(), length_,
-               options_.run.model["scheme"].exists() ? options_.run.model["scheme"].as<std::string>() : "shared",
-               count);
+               net_->options().scheme, count);
 }
 
 double SequenceTrainer::iterate(at::Generator& rng, std::map<std::string, double>& parts) {
@@ -310,13 +309,6 @@ train::TrainResult SequenceTrainer::fit(const RunDir& run, const train::FitLimit
   return result;
 }
 
-bool is_sequence_run(const fs::path& run) {
-  const fs::path file = run / "config.yaml";
-  if (!fs::exists(file)) return false;
-  const config::Node task = config::Config::load(file).root()["task"];
-  return task.exists() && task.as<std::string>() == "sequence";
-}
-
 namespace {
 
 /// Sums of one metric over a character's predictions.
@@ -384,7 +376,9 @@ eval::EvalReport evaluate_sequence(const RunDir& run, const eval::EvalOptions& o
       for (int a = q.test_begin; a + 2 + c.sequences.horizons.front() < q.test_end; ++a) {
         const int l = a + 2;
         const int reach = std::min(H, q.test_end - 1 - l);  // frames l+1..l+reach are held out
-        const auto ground = [&](int h) { return q.positions[static_cast<std::size_t>(l + h)]; };
+        const auto ground = [&](int h) -> const Eigen::MatrixXd& {
+          return q.positions[static_cast<std::size_t>(l + h)];
+        };
         const auto score = [&](const std::string& key, int h, const Eigen::MatrixXd& features) {
           tally[key].add(mean_distance_mm(ch.acap->decode(features, ground(h)), ground(h)));
         };

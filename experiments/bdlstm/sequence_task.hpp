@@ -145,7 +145,4 @@ class SequenceTrainer {
 /// file comment. Throws as eval::evaluate, and Error for a part other than `test`.
 eval::EvalReport evaluate_sequence(const RunDir& run, const eval::EvalOptions& options);
 
-/// Whether `run`'s config.yaml says `task: sequence`.
-bool is_sequence_run(const std::filesystem::path& run);
-
 }  // namespace skinlab::bdlstm
