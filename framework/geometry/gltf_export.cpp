@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <sstream>
@@ -66,15 +67,74 @@ std::vector<std::vector<std::pair<int, float>>> kept_influences(const SparseWeig
   return out;
 }
 
+/// A float32 VEC3 accessor over the rows of P (#P×3), in buffer 0; with `bounds`, its min/max
+/// (which the specification requires of POSITION accessors, morph targets included).
+int add_vec3_accessor(tinygltf::Model& model, const Eigen::MatrixXd& P, bool bounds) {
+  const auto n = static_cast<std::size_t>(P.rows());
+  std::vector<float> values(n * 3);
+  std::vector<double> lo(3, std::numeric_limits<double>::infinity());
+  std::vector<double> hi(3, -std::numeric_limits<double>::infinity());
+  for (std::size_t v = 0; v < n; ++v) {
+    for (int a = 0; a < 3; ++a) {
+      const float x = static_cast<float>(P(static_cast<Eigen::Index>(v), a));
+      values[v * 3 + a] = x;
+      lo[a] = std::min(lo[a], static_cast<double>(x));
+      hi[a] = std::max(hi[a], static_cast<double>(x));
+    }
+  }
+  const int accessor = add_accessor(model, values.data(), values.size() * sizeof(float),
+                                    TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n,
+                                    TINYGLTF_TARGET_ARRAY_BUFFER);
+  if (bounds) {
+    model.accessors[accessor].minValues = lo;
+    model.accessors[accessor].maxValues = hi;
+  }
+  return accessor;
+}
+
+/// A triangle primitive with POSITION V (#V×3) and unsigned 32-bit indices F (#F×3).
+tinygltf::Primitive triangle_primitive(tinygltf::Model& model, const Eigen::MatrixXd& V,
+                                       const Eigen::MatrixXi& F) {
+  tinygltf::Primitive primitive;
+  primitive.mode = TINYGLTF_MODE_TRIANGLES;
+  primitive.attributes["POSITION"] = add_vec3_accessor(model, V, true);
+  std::vector<std::uint32_t> indices(static_cast<std::size_t>(F.rows()) * 3);
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    for (int c = 0; c < 3; ++c) {
+      indices[static_cast<std::size_t>(f) * 3 + c] = static_cast<std::uint32_t>(F(f, c));
+    }
+  }
+  primitive.indices = add_accessor(model, indices.data(), indices.size() * sizeof(std::uint32_t),
+                                   TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
+                                   indices.size(), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+  return primitive;
+}
+
+/// Serialises `model` to `file` (.glb binary, .gltf JSON with an embedded buffer), atomically.
+void write_model(const std::filesystem::path& file, tinygltf::Model& model) {
+  std::ostringstream stream;
+  tinygltf::TinyGLTF writer;
+  const bool binary = file.extension() == ".glb";
+  if (!writer.WriteGltfSceneToStream(&model, stream, /*prettyPrint=*/!binary, binary)) {
+    throw IoError(file.string() + ": TinyGLTF could not serialise the asset");
+  }
+  write_file_atomic(file, stream.str());
+}
+
+/// Throws Error naming `file` unless it ends in .glb or .gltf.
+void check_gltf_extension(const std::filesystem::path& file) {
+  const std::string ext = file.extension().string();
+  if (ext != ".glb" && ext != ".gltf") {
+    throw Error(file.string() + ": unknown glTF extension '" + ext + "' (use .glb or .gltf)");
+  }
+}
+
 }  // namespace
 
 void write_gltf(const std::filesystem::path& file, const Character& character,
                 const GltfExportOptions& options) {
   const std::string where = file.string();
-  const std::string ext = file.extension().string();
-  if (ext != ".glb" && ext != ".gltf") {
-    throw Error(where + ": unknown glTF extension '" + ext + "' (use .glb or .gltf)");
-  }
+  check_gltf_extension(file);
   if (options.max_influences < 1 || options.max_influences > 8) {
     throw Error(where + ": max_influences must be in 1..8, got " +
                 std::to_string(options.max_influences));
@@ -143,47 +203,10 @@ void write_gltf(const std::filesystem::path& file, const Character& character,
   }
 
   // Geometry.
-  std::vector<float> positions(static_cast<std::size_t>(nv) * 3);
-  std::vector<double> lo(3, std::numeric_limits<double>::infinity());
-  std::vector<double> hi(3, -std::numeric_limits<double>::infinity());
-  for (int v = 0; v < nv; ++v) {
-    for (int a = 0; a < 3; ++a) {
-      const float x = static_cast<float>(mesh.V(v, a));
-      positions[static_cast<std::size_t>(v) * 3 + a] = x;
-      lo[a] = std::min(lo[a], static_cast<double>(x));
-      hi[a] = std::max(hi[a], static_cast<double>(x));
-    }
-  }
-  tinygltf::Primitive primitive;
-  primitive.mode = TINYGLTF_MODE_TRIANGLES;
-  const int position_accessor =
-      add_accessor(model, positions.data(), positions.size() * sizeof(float),
-                   TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, nv,
-                   TINYGLTF_TARGET_ARRAY_BUFFER);
-  model.accessors[position_accessor].minValues = lo;
-  model.accessors[position_accessor].maxValues = hi;
-  primitive.attributes["POSITION"] = position_accessor;
+  tinygltf::Primitive primitive = triangle_primitive(model, mesh.V, mesh.F);
   if (options.normals.rows() == nv) {
-    std::vector<float> normals(static_cast<std::size_t>(nv) * 3);
-    for (int v = 0; v < nv; ++v) {
-      for (int a = 0; a < 3; ++a) {
-        normals[static_cast<std::size_t>(v) * 3 + a] = static_cast<float>(options.normals(v, a));
-      }
-    }
-    primitive.attributes["NORMAL"] =
-        add_accessor(model, normals.data(), normals.size() * sizeof(float),
-                     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, nv,
-                     TINYGLTF_TARGET_ARRAY_BUFFER);
+    primitive.attributes["NORMAL"] = add_vec3_accessor(model, options.normals, false);
   }
-  std::vector<std::uint32_t> indices(static_cast<std::size_t>(mesh.num_faces()) * 3);
-  for (int f = 0; f < mesh.num_faces(); ++f) {
-    for (int c = 0; c < 3; ++c) {
-      indices[static_cast<std::size_t>(f) * 3 + c] = static_cast<std::uint32_t>(mesh.F(f, c));
-    }
-  }
-  primitive.indices = add_accessor(model, indices.data(), indices.size() * sizeof(std::uint32_t),
-                                   TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
-                                   indices.size(), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
 
   // Weights, four influences per set.
   const auto kept = kept_influences(character.weights, options.max_influences, where);
@@ -257,13 +280,88 @@ void write_gltf(const std::filesystem::path& file, const Character& character,
   model.scenes.push_back(std::move(scene));
   model.defaultScene = 0;
 
-  std::ostringstream stream;
-  tinygltf::TinyGLTF writer;
-  const bool binary = ext == ".glb";
-  if (!writer.WriteGltfSceneToStream(&model, stream, /*prettyPrint=*/!binary, binary)) {
-    throw IoError(where + ": TinyGLTF could not serialise the asset");
+  write_model(file, model);
+}
+
+void write_gltf_morph_animation(const std::filesystem::path& file, const std::string& name,
+                                const Eigen::MatrixXi& F, const std::vector<Eigen::MatrixXd>& frames,
+                                double fps) {
+  const std::string where = file.string();
+  check_gltf_extension(file);
+  if (frames.empty()) throw Error(where + ": no frame to write");
+  if (!(fps > 0) || !std::isfinite(fps)) {
+    throw Error(where + ": frames per second must be positive, got " + std::to_string(fps));
   }
-  write_file_atomic(file, stream.str());
+  const Eigen::MatrixXd& base = frames.front();
+  for (std::size_t t = 0; t < frames.size(); ++t) {
+    if (frames[t].rows() != base.rows() || frames[t].cols() != 3) {
+      throw Error(where + ": frame " + std::to_string(t) + " is " + std::to_string(frames[t].rows()) +
+                  "×" + std::to_string(frames[t].cols()) + ", expected " +
+                  std::to_string(base.rows()) + "×3 like frame 0");
+    }
+    if (!frames[t].allFinite()) {
+      throw Error(where + ": frame " + std::to_string(t) + " has a non-finite coordinate");
+    }
+  }
+  if (F.size() > 0 && (F.minCoeff() < 0 || F.maxCoeff() >= base.rows())) {
+    throw Error(where + ": a face index is outside 0.." + std::to_string(base.rows() - 1));
+  }
+
+  tinygltf::Model model;
+  model.asset.version = "2.0";
+  model.asset.generator = "skinlab";
+  model.buffers.emplace_back();
+  tinygltf::Primitive primitive = triangle_primitive(model, base, F);
+  const std::size_t targets = frames.size() - 1;
+  for (std::size_t t = 1; t < frames.size(); ++t) {
+    primitive.targets.push_back({{"POSITION", add_vec3_accessor(model, frames[t] - base, true)}});
+  }
+  tinygltf::Mesh mesh;
+  mesh.name = name;
+  mesh.primitives.push_back(std::move(primitive));
+  mesh.weights.assign(targets, 0.0);
+  model.meshes.push_back(std::move(mesh));
+  tinygltf::Node node;
+  node.name = name;
+  node.mesh = 0;
+  model.nodes.push_back(std::move(node));
+  tinygltf::Scene scene;
+  scene.name = name;
+  scene.nodes = {0};
+  model.scenes.push_back(std::move(scene));
+  model.defaultScene = 0;
+
+  if (targets > 0) {
+    // Keyframe k (time k / fps) shows frame k: target k − 1 at weight 1, every other at 0.
+    std::vector<float> times(frames.size());
+    std::vector<float> weights(frames.size() * targets, 0.0f);
+    for (std::size_t k = 0; k < frames.size(); ++k) {
+      times[k] = static_cast<float>(static_cast<double>(k) / fps);
+      if (k > 0) weights[k * targets + (k - 1)] = 1.0f;
+    }
+    const int input = add_accessor(model, times.data(), times.size() * sizeof(float),
+                                   TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR,
+                                   times.size(), /*target: none*/ 0);
+    model.accessors[input].minValues = {times.front()};
+    model.accessors[input].maxValues = {times.back()};
+    const int output = add_accessor(model, weights.data(), weights.size() * sizeof(float),
+                                    TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR,
+                                    weights.size(), /*target: none*/ 0);
+    tinygltf::Animation animation;
+    animation.name = name;
+    tinygltf::AnimationSampler sampler;
+    sampler.input = input;
+    sampler.output = output;
+    sampler.interpolation = "LINEAR";
+    animation.samplers.push_back(sampler);
+    tinygltf::AnimationChannel channel;
+    channel.sampler = 0;
+    channel.target_node = 0;
+    channel.target_path = "weights";
+    animation.channels.push_back(channel);
+    model.animations.push_back(std::move(animation));
+  }
+  write_model(file, model);
 }
 
 }  // namespace skinlab::geometry

@@ -31,6 +31,8 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <string>
+#include <vector>
 
 #include "framework/geometry/skin_weights.hpp"
 
@@ -48,5 +50,17 @@ struct GltfExportOptions {
 /// bad option and a character without weights, and IoError when the file cannot be written.
 void write_gltf(const std::filesystem::path& file, const Character& character,
                 const GltfExportOptions& options = {});
+
+/// A mesh animation as a glTF 2.0 asset of morph targets (Sec. 3.7.2.2 "Morph Targets",
+/// Sec. 3.11 "Animations"), which Blender imports as shape keys and a viewer plays: the mesh
+/// (faces F, #F×3) in frames[0], one morph target per later frame t holding frames[t] − frames[0],
+/// and one animation of the node's morph weights in which keyframe t (time t / fps) sets target
+/// t − 1 to 1 and the others to 0, linearly interpolated in between, so playback morphs from
+/// frame to frame. Written atomically; `.glb` or `.gltf` by extension. Throws Error for another
+/// extension, no frame, fps ≤ 0, a frame whose size differs from frame 0's (naming it), a
+/// non-finite coordinate or a face index out of range; IoError when the file cannot be written.
+void write_gltf_morph_animation(const std::filesystem::path& file, const std::string& name,
+                                const Eigen::MatrixXi& F, const std::vector<Eigen::MatrixXd>& frames,
+                                double fps);
 
 }  // namespace skinlab::geometry
