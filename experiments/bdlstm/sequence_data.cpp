@@ -4,13 +4,20 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <filesystem>
 
 #include "framework/core/error.hpp"
 #include "framework/data/tensors.hpp"
 #include "framework/geometry/lbs.hpp"
+#include "framework/geometry/normalize.hpp"
+#include "framework/geometry/obj_io.hpp"
+#include "framework/geometry/one_ring.hpp"
 
 namespace skinlab::bdlstm {
+
+namespace fs = std::filesystem;
 
 SequenceOptions SequenceOptions::from(const config::Node& node, std::vector<std::string> other_keys) {
   SequenceOptions o;
@@ -24,6 +31,12 @@ SequenceOptions SequenceOptions::from(const config::Node& node, std::vector<std:
   std::int64_t seed = 0;
   f.optional("seed", seed).check(seed >= 0, "seed", "must be ≥ 0");
   o.seed = static_cast<std::uint64_t>(seed);
+  f.optional("folder", o.folder);
+  std::vector<double> up{0, 1, 0};
+  f.optional("up", up).check(up.size() == 3 && Eigen::Vector3d(up[0], up[1], up.back()).norm() > 0 &&
+                                 std::all_of(up.begin(), up.end(), [](double x) { return std::isfinite(x); }),
+                             "up", "must be a non-zero 3-vector, e.g. [0, 0, 1]");
+  o.up = Eigen::Vector3d(up[0], up[1], up[2]);
   f.finish();
   return o;
 }
@@ -47,7 +60,7 @@ std::pair<int, int> held_out_window(int frames, double fraction, std::uint64_t s
 
 SequenceData::SequenceData(const data::Dataset& dataset, const std::string& file,
                            const SequenceOptions& options)
-    : options_(options) {
+    : options_(options), source_(file) {
   std::vector<int> selected;
   if (options.characters.empty()) {
     for (std::size_t i = 0; i < dataset.characters.size(); ++i) selected.push_back(static_cast<int>(i));
@@ -80,12 +93,6 @@ SequenceData::SequenceData(const data::Dataset& dataset, const std::string& file
         throw IoError(fmt::format("{}: clip '{}' of character '{}' does not have its {} joints",
                                   file, a.name, c.name, J));
       }
-      const int sampled = (a.num_frames + options.frame_stride - 1) / options.frame_stride;
-      if (sampled < options.min_frames) {
-        excluded_.push_back(fmt::format("{}/{}: {} sampled frames, fewer than min_frames = {}",
-                                        c.name, a.name, sampled, options.min_frames));
-        continue;
-      }
       std::vector<Eigen::Isometry3d> bind_inverse;
       for (std::size_t j = 0; j < J; ++j) {
         bind_inverse.push_back(data::joint_transform(a.bind.data() + 12 * j).inverse());
@@ -101,21 +108,156 @@ SequenceData::SequenceData(const data::Dataset& dataset, const std::string& file
         }
         s.positions.push_back(geometry::lbs(out.rest.V, c.weights, pose));
       }
-      s.features = out.acap->encode_sequence(s.positions);
-      std::tie(s.test_begin, s.test_end) = held_out_window(
-          s.num_frames(), options.test_fraction, options.seed, c.name + "/" + a.name);
-      out.sequences.push_back(std::move(s));
+      add_sequence(out, std::move(s));
     }
-    if (out.sequences.empty()) {
-      excluded_.push_back(c.name + ": no clip with at least min_frames sampled frames");
-      continue;
-    }
-    characters_.push_back(std::move(out));
+    add_character(std::move(out), "no clip with at least min_frames sampled frames");
   }
+  finish();
+}
+
+namespace {
+
+/// File names in natural order: runs of digits compare by value ("frame2" < "frame10").
+bool natural_less(const std::string& a, const std::string& b) {
+  std::size_t i = 0, j = 0;
+  while (i < a.size() && j < b.size()) {
+    if (std::isdigit(static_cast<unsigned char>(a[i])) && std::isdigit(static_cast<unsigned char>(b[j]))) {
+      std::size_t ie = i, je = j;
+      while (ie < a.size() && std::isdigit(static_cast<unsigned char>(a[ie]))) ++ie;
+      while (je < b.size() && std::isdigit(static_cast<unsigned char>(b[je]))) ++je;
+      std::string da = a.substr(i, ie - i), db = b.substr(j, je - j);
+      da.erase(0, std::min(da.find_first_not_of('0'), da.size()));
+      db.erase(0, std::min(db.find_first_not_of('0'), db.size()));
+      if (da.size() != db.size()) return da.size() < db.size();
+      if (da != db) return da < db;
+      i = ie;
+      j = je;
+    } else {
+      if (a[i] != b[j]) return a[i] < b[j];
+      ++i;
+      ++j;
+    }
+  }
+  return a.size() - i < b.size() - j;
+}
+
+/// The sub-directories (or, with `ext`, the regular files of that extension) of `dir`, sorted.
+std::vector<fs::path> entries(const fs::path& dir, const std::string& ext = "") {
+  std::vector<fs::path> out;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir)) {
+    if (ext.empty() ? e.is_directory() : e.is_regular_file() && e.path().extension() == ext) {
+      out.push_back(e.path());
+    }
+  }
+  std::sort(out.begin(), out.end(), [](const fs::path& a, const fs::path& b) {
+    return natural_less(a.filename().string(), b.filename().string());
+  });
+  return out;
+}
+
+/// A frame of a folder sequence, checked against the template (`file` named in errors).
+Eigen::MatrixXd read_frame(const fs::path& file, const geometry::Mesh& rest, const fs::path& rest_file) {
+  const geometry::Mesh m = geometry::read_obj(file);
+  if (m.num_vertices() != rest.num_vertices()) {
+    throw IoError(fmt::format("{}: {} vertices, but the template {} has {} (every frame of a "
+                              "sequence needs the template's vertices, in its order)",
+                              file.string(), m.num_vertices(), rest_file.string(), rest.num_vertices()));
+  }
+  if (m.F.rows() != rest.F.rows()) {
+    throw IoError(fmt::format("{}: {} faces, but the template {} has {}", file.string(), m.F.rows(),
+                              rest_file.string(), rest.F.rows()));
+  }
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
+    if (m.F.row(f) != rest.F.row(f)) {
+      throw IoError(fmt::format("{}: face {} is ({}, {}, {}), the template's is ({}, {}, {}) "
+                                "(a sequence has fixed connectivity)",
+                                file.string(), f, m.F(f, 0), m.F(f, 1), m.F(f, 2), rest.F(f, 0),
+                                rest.F(f, 1), rest.F(f, 2)));
+    }
+  }
+  return m.V;
+}
+
+}  // namespace
+
+SequenceData::SequenceData(const SequenceOptions& options) : options_(options), source_(options.folder) {
+  const fs::path root(options.folder);
+  if (options.folder.empty() || !fs::is_directory(root)) {
+    throw IoError(fmt::format("{}: not a directory (sequences.folder)", options.folder));
+  }
+  std::vector<fs::path> selected;
+  if (options.characters.empty()) {
+    selected = entries(root);
+  } else {
+    for (const std::string& name : options.characters) {
+      if (!fs::is_directory(root / name)) {
+        throw IoError(fmt::format("{}: no character folder '{}' (sequences.characters)", root.string(), name));
+      }
+      selected.push_back(root / name);
+    }
+  }
+  for (const fs::path& dir : selected) {
+    const std::string name = dir.filename().string();
+    const std::vector<fs::path> clips = entries(dir);
+    fs::path rest_file = dir / "template.obj";
+    if (!fs::exists(rest_file)) {
+      const auto first = std::find_if(clips.begin(), clips.end(),
+                                      [](const fs::path& c) { return !entries(c, ".obj").empty(); });
+      if (first == clips.end()) {
+        excluded_.push_back(name + ": no clip folder with .obj frames");
+        continue;
+      }
+      rest_file = entries(*first, ".obj").front();
+    }
+    geometry::Character rest;
+    rest.name = name;
+    rest.mesh = geometry::read_obj(rest_file);
+    const geometry::Similarity to_metres = geometry::normalize(rest, {options.up, 1.0});
+    SequenceCharacter out;
+    out.name = name;
+    out.dataset_index = static_cast<int>(characters_.size());
+    out.rest = rest.mesh;
+    out.acap = std::make_shared<const geometry::AcapEncoder>(out.rest, rest_file.string());
+    out.one_ring = data::to_long(data::RowMatrixXi(geometry::one_ring(out.rest).edges.transpose()));
+    for (const fs::path& clip : clips) {
+      const std::vector<fs::path> files = entries(clip, ".obj");
+      MeshSequence s;
+      s.clip = clip.filename().string();
+      for (std::size_t f = 0; f < files.size(); f += static_cast<std::size_t>(options.frame_stride)) {
+        s.positions.push_back(to_metres.apply(read_frame(files[f], rest.mesh, rest_file)));
+      }
+      add_sequence(out, std::move(s));
+    }
+    add_character(std::move(out), "no clip with at least min_frames frames");
+  }
+  finish();
+}
+
+void SequenceData::add_sequence(SequenceCharacter& out, MeshSequence s) {
+  if (s.num_frames() < options_.min_frames) {
+    excluded_.push_back(fmt::format("{}/{}: {} sampled frames, fewer than min_frames = {}", out.name,
+                                    s.clip, s.num_frames(), options_.min_frames));
+    return;
+  }
+  s.features = out.acap->encode_sequence(s.positions);
+  std::tie(s.test_begin, s.test_end) =
+      held_out_window(s.num_frames(), options_.test_fraction, options_.seed, out.name + "/" + s.clip);
+  out.sequences.push_back(std::move(s));
+}
+
+void SequenceData::add_character(SequenceCharacter out, const std::string& why_empty) {
+  if (out.sequences.empty()) {
+    excluded_.push_back(out.name + ": " + why_empty);
+    return;
+  }
+  characters_.push_back(std::move(out));
+}
+
+void SequenceData::finish() {
   for (const std::string& e : excluded_) spdlog::info("sequences: left out {}", e);
   if (characters_.empty()) {
-    throw IoError(fmt::format("{}: no character with a clip of at least {} sampled frames", file,
-                              options.min_frames));
+    throw IoError(fmt::format("{}: no character with a clip of at least {} sampled frames", source_,
+                              options_.min_frames));
   }
 }
 

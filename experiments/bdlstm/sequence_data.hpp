@@ -51,8 +51,12 @@ namespace skinlab::bdlstm {
 ///       min_frames: 8         # clips with fewer sampled frames are left out, with the reason
 ///       test_fraction: 0.2    # the held-out subsequence of each sequence (Sec. 4.1)
 ///       seed: 0               # draws the held-out windows
+///       folder: ""            # a folder of OBJ sequences instead of the dataset file (below)
+///       up: [0, 1, 0]         # a folder's up axis (its meshes are turned to Y up)
 struct SequenceOptions {
   std::vector<std::string> characters;
+  std::string folder;
+  Eigen::Vector3d up = Eigen::Vector3d::UnitY();
   int frame_stride = 1;
   int min_frames = 8;
   double test_fraction = 0.2;
@@ -84,6 +88,23 @@ struct SequenceCharacter {
 
 class SequenceData {
  public:
+  /// A user's own sequences (e.g. Dyna's registrations), read from `options.folder`:
+  ///
+  ///     <folder>/<character>/template.obj      # optional: the template (Sec. 3.1)
+  ///     <folder>/<character>/<clip>/*.obj      # one clip, its frames in natural name order
+  ///                                            # (frame2.obj before frame10.obj)
+  ///
+  /// Every frame of a character must have its template's vertices (in the same order) and
+  /// faces; without template.obj the template is the first frame of the first clip (the
+  /// paper's "first mesh"). Each character is rotated so that `options.up` becomes +Y, then
+  /// scaled and moved by the similarity that makes its template 1 m tall with its lowest point
+  /// at y = 0 (geometry/normalize.hpp), so errors are in the same 1 m frame as the game
+  /// characters'. Characters and clips are sub-directories in sorted order (`characters`
+  /// selects among them); fps is unknown (0). Throws IoError naming the folder, the file and
+  /// the vertex or face for a missing folder, an unreadable OBJ, or a frame whose vertex count
+  /// or faces differ from its template's; and as the other constructor when nothing is left.
+  explicit SequenceData(const SequenceOptions& options);
+
   /// Builds the sequences of every selected character of `dataset` (read from `file`, named in
   /// messages). A character without clips, and a clip with fewer than `min_frames` sampled
   /// frames, is left out with the reason (`excluded()`). Throws IoError naming the file for a
@@ -93,12 +114,22 @@ class SequenceData {
                const SequenceOptions& options);
 
   const SequenceOptions& options() const { return options_; }
+  /// Where the sequences came from (the dataset file or the folder), for messages.
+  const std::string& source() const { return source_; }
   const std::vector<SequenceCharacter>& characters() const { return characters_; }
   /// "character: reason" or "character/clip: reason" for each thing left out.
   const std::vector<std::string>& excluded() const { return excluded_; }
 
  private:
+  /// Encodes `positions`, draws its held-out window and adds it to `out`, or records it as
+  /// excluded when it has fewer than min_frames frames.
+  void add_sequence(SequenceCharacter& out, MeshSequence sequence);
+  /// Keeps `out` if it has a sequence (else records why not); throws when nothing is left.
+  void add_character(SequenceCharacter out, const std::string& why_empty);
+  void finish();
+
   SequenceOptions options_;
+  std::string source_;
   std::vector<SequenceCharacter> characters_;
   std::vector<std::string> excluded_;
 };

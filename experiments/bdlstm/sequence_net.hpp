@@ -60,16 +60,52 @@ struct SequenceNetOptions {
   static SequenceNetOptions from(const config::Node& node);
 };
 
+/// The Conv and tCnv halves of a step (Sec. 3.2), shared by the chain and the mesh VAE: the
+/// encoder's mean_convs (tanh) and the fully connected layer to μ, log σ²; the fully connected
+/// layer from a code to #V·C (tanh) and the transposed mean_convs (tanh, the last linear). Its
+/// layers are registered on the owning module as conv<i>, posterior, expand and tconv<i>, the
+/// encoder's and the decoder's in two calls so the owner can register its own layers between.
+class MeshCodec {
+ public:
+  MeshCodec(std::vector<std::int64_t> conv, std::int64_t latent, std::int64_t num_vertices,
+            torch::Tensor one_ring);
+  void register_encoder(torch::nn::Module& owner);
+  /// `code_width`: the width of what `decode` is given (the LSTM's output, or z).
+  void register_decoder(torch::nn::Module& owner, std::int64_t code_width);
+
+  /// The posterior of B frames (B×V×9): μ and log σ², each B×latent.
+  std::pair<torch::Tensor, torch::Tensor> encode(const torch::Tensor& frames);
+  /// B×V×9 from B codes (B×code_width).
+  torch::Tensor decode(const torch::Tensor& code);
+  std::int64_t num_vertices() const { return num_vertices_; }
+  std::int64_t latent() const { return latent_; }
+
+ private:
+  /// The mean_convs of `layers` on B×V×C frames: each layer's neighbour term is one sparse
+  /// product with the mesh's A (or Aᵀ) over all B frames side by side.
+  static torch::Tensor convolve(std::vector<std::shared_ptr<graph::MeanConv>>& layers,
+                                torch::Tensor x, const torch::Tensor& op);
+
+  std::vector<std::int64_t> conv_;
+  std::int64_t latent_, num_vertices_;
+  torch::Tensor mean_, mean_transpose_;  ///< A and Aᵀ of Eq. 2 (graph::mean_operator)
+  std::vector<std::shared_ptr<graph::MeanConv>> encoder_, decoder_;
+  torch::nn::Linear posterior_{nullptr}, expand_{nullptr};
+};
+
+/// D_KL(N(μ, σ²) ‖ N(0, I)) summed over the latent dimensions, averaged over the batch.
+torch::Tensor kl_divergence(const torch::Tensor& mu, const torch::Tensor& logvar);
+
 /// The Conv → cell → tCnv step of one chain, over a batch of B frames of one mesh.
 class SequenceChain : public torch::nn::Module {
  public:
-  SequenceChain(const SequenceNetOptions& options, std::int64_t num_vertices);
+  SequenceChain(const SequenceNetOptions& options, std::int64_t num_vertices, torch::Tensor one_ring);
 
   struct State {
     torch::Tensor h, c;  ///< layers × B × hidden
   };
   /// The encoder's posterior of B frames (B×V×9): μ and log σ², each B×latent.
-  std::pair<torch::Tensor, torch::Tensor> encode(const torch::Tensor& frames);
+  std::pair<torch::Tensor, torch::Tensor> encode(const torch::Tensor& frames) { return codec_.encode(frames); }
   /// One step: δX (B×V×9) from frames X_t (B×V×9) and `state` (updated). In training mode z is
   /// sampled with libtorch's default generator; the step's KL divergence to N(0, I), summed over
   /// the latent dimensions and averaged over the batch, is added to `*kl` when given.
@@ -77,21 +113,12 @@ class SequenceChain : public torch::nn::Module {
   /// s_0 = sign_b · initial_state for every sequence b of the batch (`signs`: B values ±1).
   State initial_state(const torch::Tensor& signs) const;
 
-  std::int64_t num_vertices() const { return num_vertices_; }
+  std::int64_t num_vertices() const { return codec_.num_vertices(); }
 
  private:
-  /// The mean_convs of `layers` on B×V×C frames: each layer's neighbour term is one sparse
-  /// product with the mesh's A (or Aᵀ) over all B frames side by side.
-  torch::Tensor convolve(std::vector<std::shared_ptr<graph::MeanConv>>& layers, torch::Tensor x,
-                         const torch::Tensor& op);
-
   SequenceNetOptions options_;
-  std::int64_t num_vertices_;
-  torch::Tensor mean_, mean_transpose_;  ///< A and Aᵀ of Eq. 2 (graph::mean_operator)
-  std::vector<std::shared_ptr<graph::MeanConv>> encoder_, decoder_;
-  torch::nn::Linear posterior_{nullptr}, expand_{nullptr};
+  MeshCodec codec_;
   torch::nn::LSTM cell_{nullptr};
-  friend class SequenceNet;
 };
 
 /// What a pair of chains produced for a batch of training windows of L frames.
@@ -131,5 +158,44 @@ class SequenceNet : public torch::nn::Module {
   SequenceNetOptions options_;
   std::shared_ptr<SequenceChain> forward_, backward_;
 };
+
+/// The mesh VAE of Table 1's "[4]" row (Tan et al., "Variational Autoencoders for Deforming
+/// 3D Mesh Models", CVPR 2018): a frame's features are encoded to a latent z and decoded back,
+/// with no temporal model; a sequence is continued by extrapolating linearly in its latent space
+/// from two initial frames, z_{l+h} = z_l + h (z_l − z_{l−1}) (Sec. 4.2, Fig. 5 (c)). Tan et al.
+/// use fully connected layers on their RIMD features; ours encodes and decodes with the same
+/// Conv and tCnv as the BiLSTM (MeshCodec) on the same ACAP features, so the Table 1 rows differ
+/// in the temporal model only.
+///
+///     model:
+///       type: mesh_vae
+///       conv: [9, 9, 9]
+///       latent: 128
+struct MeshVaeOptions {
+  std::vector<std::int64_t> conv{9, 9, 9};
+  std::int64_t latent = 128;
+  static MeshVaeOptions from(const config::Node& node);
+};
+
+class MeshVae : public torch::nn::Module {
+ public:
+  MeshVae(const MeshVaeOptions& options, std::int64_t num_vertices, torch::Tensor one_ring);
+  /// μ and log σ² of B frames (B×V×9).
+  std::pair<torch::Tensor, torch::Tensor> encode(const torch::Tensor& frames) { return codec_.encode(frames); }
+  torch::Tensor decode(const torch::Tensor& z) { return codec_.decode(z); }
+  /// Reconstructions of B frames (z sampled in training mode, μ otherwise) and, when given,
+  /// the batch's KL divergence in `*kl`.
+  torch::Tensor reconstruct(const torch::Tensor& frames, torch::Tensor* kl = nullptr);
+  /// The frames h = 1..count after `last`, decoded from z_last + h (z_last − z_previous) (μ's).
+  std::vector<torch::Tensor> extrapolate(const torch::Tensor& previous, const torch::Tensor& last,
+                                         int count);
+
+ private:
+  MeshCodec codec_;
+};
+
+/// `bdlstm` or `mesh_vae`: the `type` of a sequence task's `model:` node (ConfigError naming the
+/// file and line for anything else).
+std::string sequence_model_type(const config::Node& node);
 
 }  // namespace skinlab::bdlstm

@@ -10,10 +10,15 @@
 #include <filesystem>
 #include <limits>
 
+#include <unistd.h>
+
+#include "framework/core/atomic_file.hpp"
 #include "framework/core/environment.hpp"
 #include "framework/core/error.hpp"
 #include "framework/core/progress.hpp"
 #include "framework/core/timing.hpp"
+#include "framework/geometry/gltf_export.hpp"
+#include "framework/geometry/obj_io.hpp"
 #include "framework/train/checkpoint.hpp"
 #include "framework/train/fit_support.hpp"
 
@@ -23,6 +28,10 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
 namespace {
+
+constexpr const char* kNeedsData =
+    "needs a 'data' section, e.g. data: {file: results/datasets/zeroad_sequences.h5}, or "
+    "sequences.folder (a folder of OBJ sequences)";
 
 const char* const kTaskKeys[] = {"window",         "batch",    "iterations_per_epoch",
                                  "objective",      "initial_frames", "horizons", "baseline"};
@@ -63,7 +72,10 @@ std::vector<Eigen::MatrixXd> training_frames(const SequenceCharacter& c) {
   return out;
 }
 
-std::unique_ptr<SequenceData> make_data(const train::RunData& run_data, const SequenceConfig& c) {
+/// The sequences of a config: its `sequences.folder` of OBJ sequences, else its dataset file.
+std::unique_ptr<SequenceData> make_data(const SequenceConfig& c) {
+  if (!c.sequences.data.folder.empty()) return std::make_unique<SequenceData>(c.sequences.data);
+  const train::RunData run_data(c.run.data);
   return std::make_unique<SequenceData>(run_data.dataset(), c.run.data.file, c.sequences.data);
 }
 
@@ -73,7 +85,8 @@ SequenceTaskOptions SequenceTaskOptions::from(const config::Node& node) {
   SequenceTaskOptions o;
   std::vector<std::string> task_keys(std::begin(kTaskKeys), std::end(kTaskKeys));
   o.data = SequenceOptions::from(node, task_keys);
-  config::Fields f(node, "sequences", {"characters", "frame_stride", "min_frames", "test_fraction", "seed"});
+  config::Fields f(node, "sequences",
+                   {"characters", "frame_stride", "min_frames", "test_fraction", "seed", "folder", "up"});
   f.optional("window", o.window).check(o.window >= 2, "window", "must be ≥ 2 frames");
   f.optional("batch", o.batch).check(o.batch >= 1, "batch", "must be ≥ 1");
   f.optional("iterations_per_epoch", o.iterations_per_epoch)
@@ -103,8 +116,14 @@ SequenceConfig SequenceConfig::from(const config::Config& config) {
                       "'; the mesh-sequence task needs `task: sequence`");
   }
   c.sequences = SequenceTaskOptions::from(c.run.sequences);
+  c.has_data = !c.sequences.data.folder.empty() || c.run.data_node.exists();
   if (c.run.model.exists()) {
-    SequenceNetOptions::from(c.run.model);
+    c.model_type = sequence_model_type(c.run.model);
+    if (c.model_type == "bdlstm") {
+      SequenceNetOptions::from(c.run.model);
+    } else {
+      MeshVaeOptions::from(c.run.model);
+    }
     if (!c.sequences.baseline.empty()) {
       c.run.model.fail("a sequence config has a 'model' to train or a 'sequences.baseline' to "
                        "evaluate, not both");
@@ -127,6 +146,27 @@ ScaledCharacter scale_character(const SequenceCharacter& character) {
     out.frames.push_back(std::move(frames));
   }
   return out;
+}
+
+std::shared_ptr<MeshVae> build_vae(const SequenceConfig& config, const SequenceCharacter& character) {
+  torch::manual_seed(static_cast<std::uint64_t>(config.run.seed));
+  return std::make_shared<MeshVae>(MeshVaeOptions::from(config.run.model), character.num_vertices(),
+                                   character.one_ring);
+}
+
+torch::Tensor vae_loss(MeshVae& vae, const torch::Tensor& frames, const Objective& objective,
+                       std::map<std::string, double>* parts) {
+  torch::Tensor kl;
+  const torch::Tensor recon =
+      (vae.reconstruct(frames, &kl) - frames).reshape({frames.size(0), -1}).norm(2, 1).mean();
+  torch::Tensor l2 = torch::zeros({});
+  for (const auto& p : vae.parameters()) l2 = l2 + p.pow(2).sum();
+  if (parts) {
+    (*parts)["recon"] += recon.item<double>();
+    (*parts)["kl"] += kl.item<double>();
+    (*parts)["l2"] += l2.item<double>();
+  }
+  return objective.recon * recon + objective.kl * kl + objective.l2 * l2;
 }
 
 std::shared_ptr<SequenceNet> build_network(const SequenceConfig& config,
@@ -163,23 +203,18 @@ torch::Tensor sequence_loss(SequenceNet& net, const Rollout& rollout,
 }
 
 SequenceTrainer::SequenceTrainer(const config::Config& config)
-    : options_(SequenceConfig::from(config)), run_data_([&] {
-        if (!options_.sequences.baseline.empty()) {
-          throw ConfigError(config.source() + ": sequences.baseline '" + options_.sequences.baseline +
-                            "' is not trained; evaluate it with `skinlab eval " + config.source() +
-                            " --split test`");
-        }
-        if (!options_.run.model.exists()) {
-          throw ConfigError(config.source() + ": training needs a 'model' section, e.g. "
-                            "model: {type: bdlstm}");
-        }
-        if (!options_.run.data_node.exists()) {
-          throw ConfigError(config.source() + ": training needs a 'data' section, e.g. "
-                            "data: {file: results/datasets/zeroad_sequences.h5}");
-        }
-        return train::RunData(options_.run.data);
-      }()) {
-  data_ = make_data(run_data_, options_);
+    : options_(SequenceConfig::from(config)) {
+  if (!options_.sequences.baseline.empty()) {
+    throw ConfigError(config.source() + ": sequences.baseline '" + options_.sequences.baseline +
+                      "' is not trained; evaluate it with `skinlab eval " + config.source() +
+                      " --split test`");
+  }
+  if (!options_.run.model.exists()) {
+    throw ConfigError(config.source() + ": training needs a 'model' section, e.g. "
+                      "model: {type: bdlstm}");
+  }
+  if (!options_.has_data) throw ConfigError(config.source() + ": training " + kNeedsData);
+  data_ = make_data(options_);
   const SequenceCharacter& ch = data_->characters().front();
   scaled_ = scale_character(ch);
   // Training stretches: the frames before and after each held-out window.
@@ -193,24 +228,28 @@ SequenceTrainer::SequenceTrainer(const config::Config& config)
     }
   }
   if (longest < 2) {
-    throw IoError(options_.run.data.file + ": character '" + ch.name +
+    throw IoError(data_->source() + ": character '" + ch.name +
                   "' has no two consecutive training frames outside its held-out windows");
   }
   length_ = std::min(options_.sequences.window, longest);
   for (const auto& [s, range] : stretches) {
     for (int a = range.first; a + length_ <= range.second; ++a) windows_.emplace_back(s, a);
   }
-  net_ = build_network(options_, ch);
-  train::check_checkpointable(*net_);
+  if (options_.model_type == "mesh_vae") {
+    vae_ = build_vae(options_, ch);
+  } else {
+    net_ = build_network(options_, ch);
+  }
+  train::check_checkpointable(model());
   initial_torch_rng_ = train::get_rng_state(at::detail::getDefaultCPUGenerator());
   optimizer_ = std::make_unique<torch::optim::Adam>(
-      net_->parameters(), torch::optim::AdamOptions(options_.run.train.lr));
+      model().parameters(), torch::optim::AdamOptions(options_.run.train.lr));
   std::int64_t count = 0;
-  for (const auto& p : net_->parameters()) count += p.numel();
+  for (const auto& p : model().parameters()) count += p.numel();
   spdlog::info("sequence task: '{}' ({} vertices), {} clips, {} training windows of {} frames; "
                "{} network, {} parameters",
                ch.name, ch.num_vertices(), ch.sequences.size(), windows_.size(), length_,
-               net_->options().scheme, count);
+               net_ ? "bdlstm/" + net_->options().scheme : std::string("mesh_vae"), count);
 }
 
 double SequenceTrainer::iterate(at::Generator& rng, std::map<std::string, double>& parts) {
@@ -229,8 +268,9 @@ double SequenceTrainer::iterate(at::Generator& rng, std::map<std::string, double
   std::vector<torch::Tensor> window;
   for (auto& column : columns) window.push_back(torch::stack(column));
   optimizer_->zero_grad();
-  const Rollout rollout = net_->rollout(window);
-  const torch::Tensor loss = sequence_loss(*net_, rollout, window, options_.sequences.objective, &parts);
+  const torch::Tensor loss =
+      vae_ ? vae_loss(*vae_, torch::cat(window), options_.sequences.objective, &parts)
+           : sequence_loss(*net_, net_->rollout(window), window, options_.sequences.objective, &parts);
   const double value = loss.item<double>();
   if (!std::isfinite(value)) {
     throw Error(fmt::format("training loss is {} on character '{}'; lower train.lr?", value,
@@ -250,7 +290,7 @@ train::TrainResult SequenceTrainer::fit(const RunDir& run, const train::FitLimit
   at::Generator torch_rng = at::detail::getDefaultCPUGenerator();
   at::Generator order_rng =
       at::make_generator<at::CPUGeneratorImpl>(train::order_seed(options_.run.seed));
-  train::FitStart begun = train::start_fit(run, *net_, *optimizer_, options_.run.seed,
+  train::FitStart begun = train::start_fit(run, model(), *optimizer_, options_.run.seed,
                                            options_.run.model.to_yaml(), torch_rng, order_rng,
                                            initial_torch_rng_);
   train::TrainingState& state = begun.state;
@@ -259,7 +299,7 @@ train::TrainResult SequenceTrainer::fit(const RunDir& run, const train::FitLimit
   auto stopped_early = [&] {
     return t.patience > 0 && state.best_epoch > 0 && state.epoch - state.best_epoch >= t.patience;
   };
-  net_->train();
+  model().train();
   const auto session_start = Clock::now();
   const int iterations = options_.sequences.iterations_per_epoch;
   while (state.epoch < t.epochs && !stopped_early()) {
@@ -292,8 +332,8 @@ train::TrainResult SequenceTrainer::fit(const RunDir& run, const train::FitLimit
                         {"improved", improved},
                         {"iterations", iterations},
                         {"seconds", seconds}});
-    if (improved) save_checkpoint(run.file(train::kBestCheckpoint), *net_, optimizer_.get(), state);
-    save_checkpoint(last, *net_, optimizer_.get(), state);
+    if (improved) save_checkpoint(run.file(train::kBestCheckpoint), model(), optimizer_.get(), state);
+    save_checkpoint(last, model(), optimizer_.get(), state);
     ++result.epochs_this_call;
     const double eta = seconds_since(session_start) / result.epochs_this_call *
                        static_cast<double>(t.epochs - epoch);
@@ -340,9 +380,7 @@ eval::EvalReport evaluate_sequence(const RunDir& run, const eval::EvalOptions& o
     throw ConfigError(config.source() + ": a sequence config needs a 'model' or a "
                       "'sequences.baseline' to evaluate");
   }
-  if (!c.run.data_node.exists()) {
-    throw ConfigError(config.source() + ": evaluating a config needs a 'data' section");
-  }
+  if (!c.has_data) throw ConfigError(config.source() + ": evaluating " + kNeedsData);
   fs::path checkpoint;
   if (baseline.empty()) {
     checkpoint = train::checkpoint_file(run.path(), options.checkpoint);
@@ -351,8 +389,7 @@ eval::EvalReport evaluate_sequence(const RunDir& run, const eval::EvalOptions& o
                     "' in this run (a run writes best.pt and last.pt after its first epoch)");
     }
   }
-  train::RunData run_data(c.run.data);
-  const std::unique_ptr<SequenceData> data = make_data(run_data, c);
+  const std::unique_ptr<SequenceData> data = make_data(c);
   eval::EvalReport report;
   report.split = "held-out windows";
   report.part = options.part;
@@ -364,7 +401,12 @@ eval::EvalReport evaluate_sequence(const RunDir& run, const eval::EvalOptions& o
   for (const SequenceCharacter& ch : data->characters()) {
     const ScaledCharacter scaled = scale_character(ch);
     std::shared_ptr<SequenceNet> net;
-    if (baseline.empty()) {
+    std::shared_ptr<MeshVae> vae;
+    if (c.model_type == "mesh_vae") {
+      vae = build_vae(c, ch);
+      report.epoch = static_cast<int>(train::load_checkpoint(checkpoint, *vae).epoch);
+      vae->eval();
+    } else if (baseline.empty()) {
       net = build_network(c, ch);
       report.epoch = static_cast<int>(train::load_checkpoint(checkpoint, *net).epoch);
       net->eval();
@@ -389,6 +431,9 @@ eval::EvalReport evaluate_sequence(const RunDir& run, const eval::EvalOptions& o
             for (int t = l - u + 1; t <= l; ++t) initial.push_back(frames[static_cast<std::size_t>(t)].unsqueeze(0));
             generated[u] = net->generate(initial, reach);
           }
+        } else if (vae) {  // [4]: linear extrapolation in the latent space from 2 initial frames
+          generated[2] = vae->extrapolate(frames[static_cast<std::size_t>(l - 1)].unsqueeze(0),
+                                          frames[static_cast<std::size_t>(l)].unsqueeze(0), reach);
         }
         for (int h : c.sequences.horizons) {
           if (h > reach) break;
@@ -422,7 +467,7 @@ eval::EvalReport evaluate_sequence(const RunDir& run, const eval::EvalOptions& o
     }
     if (tally.empty()) {
       spdlog::warn("{}: no held-out window of '{}' holds 3 initial frames and the {}th frame",
-                   c.run.data.file, ch.name, c.sequences.horizons.front());
+                   data->source(), ch.name, c.sequences.horizons.front());
     }
     report.characters.push_back(std::move(r));
     progress.tick();
@@ -437,11 +482,13 @@ eval::EvalReport evaluate_sequence(const RunDir& run, const eval::EvalOptions& o
       {{"experiment", c.run.experiment},
        {"run", run.id()},
        {"task", "sequence"},
-       {"dataset", c.run.data.file},
+       {"dataset", data->source()},
        {"split", report.split},
        {"part", options.part},
        {"method", baseline.empty() ? "model" : "baseline"},
-       {"type", baseline.empty() ? "bdlstm/" + SequenceNetOptions::from(c.run.model).scheme : baseline},
+       {"type", !baseline.empty()            ? baseline
+                : c.model_type == "mesh_vae" ? std::string("mesh_vae")
+                                             : "bdlstm/" + SequenceNetOptions::from(c.run.model).scheme},
        {"checkpoint", report.checkpoint},
        {"epoch", report.epoch},
        {"metric_definitions",
@@ -452,6 +499,136 @@ eval::EvalReport evaluate_sequence(const RunDir& run, const eval::EvalOptions& o
                     "decoded; starts<h>: predictions scored (Qiao et al. Table 1)",
                     100 * c.sequences.data.test_fraction, c.sequences.data.frame_stride)}});
   return report;
+}
+
+GeneratedSequence generate_sequence(const RunDir& run, const GenerateOptions& options,
+                                    const fs::path& out) {
+  if (options.initial_frames < 1 || options.frames < 1) {
+    throw Error(fmt::format("generate: --init-frames ({}) and --frames ({}) must be ≥ 1",
+                            options.initial_frames, options.frames));
+  }
+  if (fs::exists(out) && !(fs::is_directory(out) && fs::is_empty(out))) {
+    throw Error(out.string() + ": exists; generate writes a new directory (choose another --out)");
+  }
+  const config::Config config = config::Config::load(run.file("config.yaml"), options.overrides);
+  const SequenceConfig c = SequenceConfig::from(config);
+  if (c.model_type == "mesh_vae") {
+    throw Error(run.path().string() + ": a mesh_vae run extrapolates, it does not generate; "
+                "generate needs a trained bdlstm run");
+  }
+  if (!c.sequences.baseline.empty() || !c.run.model.exists()) {
+    throw Error(run.path().string() + ": " +
+                (c.sequences.baseline.empty() ? std::string("has no model")
+                                              : "is a baseline run (" + c.sequences.baseline + ")") +
+                "; generate needs a trained bdlstm run");
+  }
+  const fs::path checkpoint = train::checkpoint_file(run.path(), options.checkpoint);
+  if (!fs::exists(checkpoint)) {
+    throw IoError(checkpoint.string() + ": no checkpoint '" + options.checkpoint + "' in this run");
+  }
+  const std::unique_ptr<SequenceData> data = make_data(c);
+  const SequenceCharacter& ch = data->characters().front();
+  const ScaledCharacter scaled = scale_character(ch);
+  std::size_t s = 0;
+  if (!options.clip.empty()) {
+    std::string clips;
+    while (s < ch.sequences.size() && ch.sequences[s].clip != options.clip) {
+      clips += (clips.empty() ? "" : ", ") + ch.sequences[s++].clip;
+    }
+    if (s == ch.sequences.size()) {
+      throw Error(fmt::format("{}: character '{}' has no clip '{}' (its clips: {})", data->source(),
+                              ch.name, options.clip, clips));
+    }
+  }
+  const MeshSequence& q = ch.sequences[s];
+  const int u = options.initial_frames;
+  const int start = options.start < 0 ? q.test_begin : options.start;
+  if (start + u > q.num_frames()) {
+    throw Error(fmt::format("{}: clip '{}' of '{}' has frames 0..{}; {} initial frames from frame "
+                            "{} do not fit",
+                            data->source(), q.clip, ch.name, q.num_frames() - 1, u, start));
+  }
+
+  auto net = build_network(c, ch);
+  GeneratedSequence result;
+  result.epoch = static_cast<int>(train::load_checkpoint(checkpoint, *net).epoch);
+  net->eval();
+  torch::NoGradGuard no_grad;
+  std::vector<torch::Tensor> initial;
+  for (int t = start; t < start + u; ++t) {
+    initial.push_back(scaled.frames[s][static_cast<std::size_t>(t)].unsqueeze(0));
+  }
+  const std::vector<torch::Tensor> generated = net->generate(initial, options.frames);
+
+  result.character = ch.name;
+  result.clip = q.clip;
+  result.start = start;
+  result.test_begin = q.test_begin;
+  result.test_end = q.test_end;
+  const Eigen::MatrixXd& last = q.positions[static_cast<std::size_t>(start + u - 1)];
+  std::vector<Eigen::MatrixXd> frames(q.positions.begin() + start, q.positions.begin() + start + u);
+  std::vector<Eigen::MatrixXd> truth = frames;
+  nlohmann::json per_frame = nlohmann::json::array();
+  for (int h = 1; h <= options.frames; ++h) {
+    const Eigen::MatrixXd features =
+        scaled.scale.denormalise(to_matrix(generated[static_cast<std::size_t>(h - 1)].squeeze(0)));
+    frames.push_back(ch.acap->decode(features, last));
+    const int t = start + u - 1 + h;
+    nlohmann::json entry = {{"frame", u - 1 + h}, {"clip_frame", t}};
+    if (t < q.num_frames()) {
+      const Eigen::MatrixXd& ground = q.positions[static_cast<std::size_t>(t)];
+      truth.push_back(ground);
+      result.error_mm.push_back(mean_distance_mm(ch.acap->decode(features, ground), ground));
+      entry["error_mm"] = result.error_mm.back();
+      entry["held_out"] = t >= q.test_begin && t < q.test_end;
+    }
+    per_frame.push_back(entry);
+  }
+
+  // Everything goes into a temporary sibling directory, renamed to `out` at the end.
+  const fs::path parent = out.parent_path().empty() ? fs::path(".") : out.parent_path();
+  fs::create_directories(parent);
+  const fs::path temp = parent / fmt::format(".{}.tmp-{}", out.filename().string(), ::getpid());
+  fs::remove_all(temp);
+  fs::create_directories(temp);
+  try {
+    const double fps = options.fps > 0 ? options.fps : (q.fps > 0 ? q.fps : 30.0);
+    const auto write_frames = [&](const std::string& stem, const std::vector<Eigen::MatrixXd>& list) {
+      for (std::size_t t = 0; t < list.size(); ++t) {
+        geometry::write_obj(temp / fmt::format("{}_{:04d}.obj", stem, t), geometry::Mesh{list[t], ch.rest.F});
+      }
+      geometry::write_gltf_morph_animation(temp / (stem == "frame" ? "sequence.glb" : "truth.glb"),
+                                           ch.name + "/" + q.clip, ch.rest.F, list, fps);
+    };
+    write_frames("frame", frames);
+    write_frames("truth", truth);
+    const nlohmann::json info = {
+        {"run", run.path().string()},
+        {"checkpoint", options.checkpoint},
+        {"epoch", result.epoch},
+        {"source", data->source()},
+        {"character", ch.name},
+        {"clip", q.clip},
+        {"start", start},
+        {"held_out_window", {q.test_begin, q.test_end}},
+        {"initial_frames", u},
+        {"generated_frames", options.frames},
+        {"fps", fps},
+        {"frames", per_frame},
+        {"note",
+         "frame_0000..: the initial frames as given, then the generated ones (parts placed at "
+         "their centroids in the last initial frame); truth_0000..: the clip over the same span; "
+         "error_mm scores a generated frame as Table 1 does (parts at their true centroids), mm "
+         "with the character 1 m tall"}};
+    write_file_atomic(temp / "generate.json", info.dump(2) + "\n");
+    if (fs::exists(out)) fs::remove(out);  // an empty directory (checked above)
+    fs::rename(temp, out);
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove_all(temp, ignored);
+    throw;
+  }
+  return result;
 }
 
 }  // namespace skinlab::bdlstm

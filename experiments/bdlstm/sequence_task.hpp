@@ -5,7 +5,7 @@
 /// sequence_data.hpp with the network of sequence_net.hpp.
 ///
 ///     task: sequence
-///     data: {file: results/datasets/zeroad_sequences.h5}
+///     data: {file: results/datasets/zeroad_sequences.h5}   # or sequences.folder (OBJ sequences)
 ///     sequences:                 # sequence_data.hpp's keys (characters, frame_stride, ...), and
 ///       window: 32               # frames per training sequence (Sec. 4.1: 32)
 ///       batch: 8                 # training sequences per iteration (Sec. 4.1: 8)
@@ -35,11 +35,15 @@
 /// backward reconstruction and no L_bidir. Adam (`train.lr`, default Adam β; Sec. 4.1).
 /// An epoch is `iterations_per_epoch` iterations; the paper trains 7,000 iterations. There is
 /// no validation set (the paper has none): best.pt is the epoch of lowest training loss.
+/// A `mesh_vae` model trains on the same windows' frames, each reconstructed on its own
+/// (vae_loss), for the same iterations.
 ///
 /// Evaluation (Table 1): only on the held-out windows (part `test`). Every start a of a window
 /// with the last initial frame l = a + 2 inside it gives up to three predictions of frame l + h
 /// for each horizon h with l + h inside the window:
 ///  - the network with u ∈ `initial_frames` initial frames X_{l−u+1..l} (metric `e<h>_<u>if_mm`);
+///  - a `mesh_vae` model ([4], sequence_net.hpp): linear extrapolation in its latent space from
+///    the two initial frames X_{l−1}, X_l (`e<h>_2if_mm`);
 ///  - `acap_extrapolation`, [24]'s linear extrapolation in ACAP feature space from the two
 ///    initial frames X_{l−1}, X_l: X_{l+h} = X_l + h (X_l − X_{l−1}) (`e<h>_2if_mm`);
 ///  - `hold`: the last initial frame repeated, X_{l+h} = X_l (`e<h>_1if_mm`), the floor any
@@ -51,6 +55,7 @@
 /// 1 m-tall frame. A character's value is the mean over its predictions; `starts<h>` counts
 /// them.
 
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -90,8 +95,10 @@ struct SequenceTaskOptions {
 struct SequenceConfig {
   train::RunOptions run;
   SequenceTaskOptions sequences;
+  bool has_data = false;  ///< a `data:` section or a `sequences.folder`
+  std::string model_type;  ///< bdlstm or mesh_vae; empty without a model
   /// Throws ConfigError for anything invalid, including another task, a model that is not a
-  /// `bdlstm`, both a model and a baseline, and a model run over anything but one character
+  /// `bdlstm` or `mesh_vae`, both a model and a baseline, and a model run over anything but one character
   /// (the network is sized by its mesh).
   static SequenceConfig from(const config::Config& config);
 };
@@ -109,6 +116,14 @@ ScaledCharacter scale_character(const SequenceCharacter& character);
 std::shared_ptr<SequenceNet> build_network(const SequenceConfig& config,
                                            const SequenceCharacter& character);
 
+/// The mesh VAE of a config for `character` (seeded as build_network).
+std::shared_ptr<MeshVae> build_vae(const SequenceConfig& config, const SequenceCharacter& character);
+
+/// The mesh VAE's objective on B frames (B×V×9): recon · mean ‖X̂ − X‖ (Frobenius per frame, as
+/// Eq. 4) + kl · L_KL + l2 · L_2; fills `parts` (recon, kl, l2) when given.
+torch::Tensor vae_loss(MeshVae& vae, const torch::Tensor& frames, const Objective& objective,
+                       std::map<std::string, double>* parts = nullptr);
+
 /// Eq. 3-5 on a rollout of `window` (L × [B×V×9]); fills `parts` (recon, bidir, kl, l2) when
 /// given.
 torch::Tensor sequence_loss(SequenceNet& net, const Rollout& rollout,
@@ -121,7 +136,13 @@ class SequenceTrainer {
   /// Adam. Nothing is written.
   explicit SequenceTrainer(const config::Config& config);
   train::TrainResult fit(const RunDir& run, const train::FitLimits& limits = {});
-  SequenceNet& network() { return *net_; }
+  /// The bdlstm network (a mesh_vae config has none: Error).
+  SequenceNet& network() {
+    if (!net_) throw Error("SequenceTrainer::network: this run trains a mesh_vae");
+    return *net_;
+  }
+  /// What is trained: the bdlstm network or the mesh VAE.
+  torch::nn::Module& model() { return net_ ? static_cast<torch::nn::Module&>(*net_) : *vae_; }
   /// The training windows' (sequence, first frame) and their length.
   const std::vector<std::pair<int, int>>& windows() const { return windows_; }
   int window_length() const { return length_; }
@@ -130,12 +151,12 @@ class SequenceTrainer {
   double iterate(at::Generator& rng, std::map<std::string, double>& parts);
 
   SequenceConfig options_;
-  train::RunData run_data_;
   std::unique_ptr<SequenceData> data_;
   ScaledCharacter scaled_;
   std::vector<std::pair<int, int>> windows_;
   int length_ = 0;
   std::shared_ptr<SequenceNet> net_;
+  std::shared_ptr<MeshVae> vae_;
   std::unique_ptr<torch::optim::Adam> optimizer_;
   torch::Tensor initial_torch_rng_;
   bool fitted_ = false;
@@ -144,5 +165,39 @@ class SequenceTrainer {
 /// Evaluates a sequence run (its checkpoint, or its baseline) on the held-out windows; see the
 /// file comment. Throws as eval::evaluate, and Error for a part other than `test`.
 eval::EvalReport evaluate_sequence(const RunDir& run, const eval::EvalOptions& options);
+
+/// What `skinlab generate` makes of a trained run (Sec. 3.2: generation from initial frames).
+struct GenerateOptions {
+  int initial_frames = 3;         ///< u: given frames X_start..X_{start+u−1}
+  int frames = 15;                ///< N: frames generated after them
+  std::string clip;               ///< default: the character's first clip
+  int start = -1;                 ///< first initial frame; −1: the clip's held-out window start
+  std::string checkpoint = "best";
+  double fps = 0;                 ///< glTF playback rate; 0: the clip's, or 30 when unknown
+  std::vector<std::string> overrides;  ///< applied to the run's config (e.g. data.file=...)
+};
+
+struct GeneratedSequence {
+  std::string character, clip;
+  int start = 0, test_begin = 0, test_end = 0, epoch = 0;
+  /// Per generated frame with a ground truth in the clip: the Table 1 error (mm, 1 m frame,
+  /// parts at their true centroids, as evaluate_sequence scores it).
+  std::vector<double> error_mm;
+};
+
+/// Generates `frames` frames of the run's character from `initial_frames` frames of one clip
+/// with the forward chain (z = μ) and writes, into the new directory `out`:
+///   frame_0000.obj …  the u initial frames as given, then the N generated ones, each decoded
+///                     with every connected part at its centroid in the last initial frame
+///                     (ACAP features carry no translation; no ground truth is used);
+///   truth_0000.obj …  the clip's own frames over the same span, as far as the clip goes;
+///   sequence.glb, truth.glb  the same as glTF morph-target animations for viewing;
+///   generate.json     run, checkpoint, clip, frames, held-out window and the per-frame errors.
+/// Frames are in the character's normalised 1 m frame. The directory is written under a
+/// temporary name and renamed at the end, so a failure leaves nothing. Throws Error when `out`
+/// exists and is not empty, for a baseline run (nothing trained), a clip the character does not
+/// have (listing its clips), or initial frames outside the clip (naming the range).
+GeneratedSequence generate_sequence(const RunDir& run, const GenerateOptions& options,
+                                    const std::filesystem::path& out);
 
 }  // namespace skinlab::bdlstm

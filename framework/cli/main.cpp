@@ -112,7 +112,7 @@ int main(int argc, char** argv) {
       skinlab::cli::add_table(app), skinlab::cli::add_curves(app), skinlab::cli::add_figure(app),
       skinlab::cli::add_sweep(app), skinlab::cli::add_predict(app),
       skinlab::cli::add_bundle(app), skinlab::cli::add_export(app),
-      skinlab::cli::add_score(app)};
+      skinlab::cli::add_score(app), skinlab::cli::add_generate(app)};
 
   try {
     app.parse(argc, argv);

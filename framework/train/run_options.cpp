@@ -123,7 +123,8 @@ void RunOptions::require_training_sections(const config::Config& config) const {
                       "`skinlab eval " + config.source() + " --split test`");
   }
   if (task == "sequence") {  // its objective is sequences.objective (Eq. 3), not `losses:`
-    require_sections(config, "training", {{&model, "model: {type: bdlstm}"}, {&data_node, kDataExample}});
+    // Its data is a `data:` file or a `sequences.folder`; SequenceTrainer checks which.
+    require_sections(config, "training", {{&model, "model: {type: bdlstm}"}});
     return;
   }
   require_sections(config, "training",

@@ -10,8 +10,13 @@
 #include <algorithm>
 #include <set>
 
+#include <fmt/format.h>
+
 #include "framework/core/error.hpp"
 #include "framework/geometry/lbs.hpp"
+#include "framework/geometry/normalize.hpp"
+#include "framework/geometry/obj_io.hpp"
+#include "tests/geometry/test_meshes.hpp"
 #include "tests/bundled_dataset.hpp"
 #include "tests/test_util.hpp"
 
@@ -158,6 +163,115 @@ TEST_F(BundledSequences, SelectionShortClipsAndErrors) {
   expect_error<ConfigError>(
       [] { SequenceOptions::from(config::Config::parse("{frames: 3}", "s.yaml").root()); },
       {"frames"});
+}
+
+// The `folder` source: the wolf's clips written as a user's OBJ sequences (one file per frame,
+// unpadded numbers so that name order is not frame order; the second copy 100 times larger and
+// Z up) read back to the same frames and features as from the dataset file.
+TEST_F(BundledSequences, FolderOfObjFramesReadsBackTheSameSequences) {
+  SequenceOptions o = options(3);
+  o.characters = {"wolf"};
+  const SequenceData from_file(*dataset_, file_, o);
+  const SequenceCharacter& wolf = from_file.characters().front();
+  // The dataset's mesh is in its 1 m frame up to what cleaning did after normalising; the folder
+  // source normalises its template exactly, a scaling and translation that leave the ACAP
+  // features as they are.
+  geometry::Character normalised;
+  normalised.name = "wolf";
+  normalised.mesh = wolf.rest;
+  const geometry::Similarity exact = geometry::normalize(normalised);
+  EXPECT_NEAR(exact.scale, 1.0, 0.05);
+  skinlab::testing::TempDir folder;
+  Eigen::Matrix3d to_z_up;  // (x, y, z) ↦ (x, −z, y): +Y becomes +Z
+  to_z_up << 1, 0, 0, 0, 0, -1, 0, 1, 0;
+  const auto moved = [&](const Eigen::MatrixXd& V) {
+    return Eigen::MatrixXd((100.0 * V * to_z_up.transpose()).rowwise() + Eigen::RowVector3d(3, 4, 5));
+  };
+  for (const MeshSequence& q : wolf.sequences) {
+    std::string clip = q.clip;
+    std::replace(clip.begin(), clip.end(), '/', '_');
+    std::filesystem::create_directories(folder / ("wolf/" + clip));
+    std::filesystem::create_directories(folder / ("big_wolf/" + clip));
+    for (int t = 0; t < q.num_frames(); ++t) {
+      const auto& V = q.positions[static_cast<std::size_t>(t)];
+      geometry::write_obj(folder / fmt::format("wolf/{}/f{}.obj", clip, t), {V, wolf.rest.F});
+      geometry::write_obj(folder / fmt::format("big_wolf/{}/f{}.obj", clip, t), {moved(V), wolf.rest.F});
+    }
+  }
+  geometry::write_obj(folder / "wolf/template.obj", wolf.rest);
+  geometry::write_obj(folder / "big_wolf/template.obj", {moved(wolf.rest.V), wolf.rest.F});
+
+  SequenceOptions f = options(1);
+  f.folder = folder.path().string();
+  f.characters = {"wolf"};
+  const SequenceData plain(f);
+  f.characters = {"big_wolf"};
+  f.up = Eigen::Vector3d::UnitZ();
+  const SequenceData big(f);
+  for (const SequenceData* read : {&plain, &big}) {
+    ASSERT_EQ(read->characters().size(), 1u);
+    const SequenceCharacter& c = read->characters().front();
+    EXPECT_EQ(read->source(), folder.path().string());
+    ASSERT_EQ(c.sequences.size(), wolf.sequences.size());
+    EXPECT_LT((c.rest.V - normalised.mesh.V).cwiseAbs().maxCoeff(), 1e-9);
+    EXPECT_TRUE(torch::equal(c.one_ring, wolf.one_ring));
+    for (const MeshSequence& a : c.sequences) {
+      const auto same = std::find_if(wolf.sequences.begin(), wolf.sequences.end(), [&](const MeshSequence& q) {
+        std::string clip = q.clip;
+        std::replace(clip.begin(), clip.end(), '/', '_');
+        return clip == a.clip;
+      });
+      ASSERT_NE(same, wolf.sequences.end()) << a.clip;
+      const MeshSequence& b = *same;
+      ASSERT_EQ(a.num_frames(), b.num_frames()) << a.clip;
+      for (int t = 0; t < a.num_frames(); ++t) {  // frame order is numeric, not by name
+        EXPECT_LT((a.positions[t] - exact.apply(b.positions[t])).cwiseAbs().maxCoeff(), 1e-9)
+            << a.clip << " " << t;
+        EXPECT_LT((a.features[t] - b.features[t]).cwiseAbs().maxCoeff(), 1e-6) << a.clip << " " << t;
+      }
+    }
+  }
+  // Without template.obj the template is the first frame of the first clip: its features are
+  // the identity's (rotation vector 0, scale I).
+  std::filesystem::remove(folder / "wolf/template.obj");
+  f.characters = {"wolf"};
+  f.up = Eigen::Vector3d::UnitY();
+  const SequenceData first_frame(f);
+  Eigen::RowVectorXd identity(9);
+  identity << 0, 0, 0, 1, 0, 0, 1, 0, 1;
+  const Eigen::MatrixXd& F0 = first_frame.characters()[0].sequences[0].features[0];
+  EXPECT_LT((F0.rowwise() - identity).cwiseAbs().maxCoeff(), 1e-6);
+}
+
+TEST(FolderSequences, FramesThatAreNotTheTemplatesMeshAreNamed) {
+  skinlab::testing::TempDir folder;
+  const geometry::Mesh grid = skinlab::testing::grid(3, 3, 0.25);
+  std::filesystem::create_directories(folder / "sheet/wave");
+  for (int t = 0; t < 8; ++t) {
+    geometry::Mesh m = grid;
+    m.V.col(2) = 0.05 * t * m.V.col(0).array().square().matrix();
+    geometry::write_obj(folder / fmt::format("sheet/wave/{:02d}.obj", t), m);
+  }
+  SequenceOptions o;
+  o.folder = folder.path().string();
+  o.min_frames = 4;
+  const SequenceData ok(o);
+  EXPECT_EQ(ok.characters().at(0).sequences.at(0).num_frames(), 8);
+
+  geometry::write_obj(folder / "sheet/wave/05.obj", skinlab::testing::grid(3, 2, 0.25));
+  expect_error<IoError>([&] { SequenceData{o}; }, {"05.obj", "12 vertices", "template", "has 16"});
+  geometry::Mesh flipped = grid;
+  std::swap(flipped.F(3, 1), flipped.F(3, 2));
+  geometry::write_obj(folder / "sheet/wave/05.obj", flipped);
+  expect_error<IoError>([&] { SequenceData{o}; }, {"05.obj", "face 3", "fixed connectivity"});
+  o.folder = (folder / "missing").string();
+  expect_error<IoError>([&] { SequenceData{o}; }, {"missing", "not a directory"});
+  o.folder = folder.path().string();
+  o.characters = {"cloth"};
+  expect_error<IoError>([&] { SequenceData{o}; }, {"no character folder 'cloth'"});
+  expect_error<ConfigError>(
+      [] { SequenceOptions::from(config::Config::parse("{up: [0, 0]}", "s.yaml").root()); },
+      {"s.yaml", "up"});
 }
 
 }  // namespace

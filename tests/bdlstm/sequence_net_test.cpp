@@ -215,5 +215,52 @@ TEST(SequenceConfig, OneMeshPerNetworkAndOneMethod) {
   expect_error<ConfigError>([&] { load({"task=skinning"}); }, {"sequences"});
 }
 
+// The chain's layers keep the names and order they had before the encoder and decoder became
+// a MeshCodec shared with the mesh VAE, so saved checkpoints and seeded initialisations hold.
+TEST(SequenceNet, ChainParametersAreNamedAndOrderedAsBefore) {
+  SequenceNet net(small("shared"), kV, ring_edges());
+  std::vector<std::string> layers;
+  for (const auto& item : net.named_parameters()) {
+    const std::string name = item.key();
+    const std::string layer = name.substr(0, name.find('.', name.find('.') + 1));
+    if (layers.empty() || layers.back() != layer) layers.push_back(layer);
+  }
+  EXPECT_EQ(layers, (std::vector<std::string>{"forward_chain.conv0", "forward_chain.conv1",
+                                              "forward_chain.posterior", "forward_chain.cell",
+                                              "forward_chain.expand", "forward_chain.tconv0",
+                                              "forward_chain.tconv1"}));
+}
+
+// [4]'s extrapolation: a mesh VAE continued from two equal frames stays at the last frame's
+// reconstruction (zero latent velocity); otherwise frame h decodes z_l + h (z_l − z_{l−1}), so
+// the latent steps between consecutive extrapolated frames are all the same.
+TEST(MeshVae, ExtrapolatesLinearlyInItsLatentSpace) {
+  MeshVaeOptions o;
+  o.conv = {5, 4};
+  o.latent = 6;
+  torch::manual_seed(1);
+  MeshVae vae(o, kV, ring_edges());
+  vae.eval();
+  torch::NoGradGuard no_grad;
+  const auto w = window(2, 2);
+  const auto still = vae.extrapolate(w[1], w[1], 3);
+  ASSERT_EQ(still.size(), 3u);
+  for (const auto& x : still) EXPECT_TRUE(torch::allclose(x, vae.reconstruct(w[1]), 1e-5, 1e-6));
+  const auto moving = vae.extrapolate(w[0], w[1], 3);
+  const torch::Tensor z0 = vae.encode(w[0]).first, z1 = vae.encode(w[1]).first;
+  for (int h = 1; h <= 3; ++h) {
+    EXPECT_TRUE(torch::allclose(moving[h - 1], vae.decode(z1 + h * (z1 - z0)), 1e-5, 1e-6)) << h;
+  }
+  EXPECT_FALSE(torch::allclose(moving[0], moving[2]));
+  // Training mode samples z; evaluation uses μ.
+  vae.train();
+  torch::Tensor kl;
+  EXPECT_FALSE(torch::equal(vae.reconstruct(w[1], &kl), vae.reconstruct(w[1])));
+  EXPECT_GT(kl.item<double>(), 0);
+  expect_error<ConfigError>(
+      [] { MeshVaeOptions::from(config::Config::parse("{type: mesh_vae, hidden: 3}", "v.yaml").root()); },
+      {"v.yaml", "hidden"});
+}
+
 }  // namespace
 }  // namespace skinlab::bdlstm

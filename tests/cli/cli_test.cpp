@@ -12,6 +12,7 @@
 
 #include "framework/core/atomic_file.hpp"
 #include "framework/data/h5.hpp"
+#include "framework/geometry/obj_io.hpp"
 #include "tests/cli/cli_run.hpp"
 #include "tests/test_util.hpp"
 
@@ -509,6 +510,7 @@ TEST(Cli, BdlstmSmokeSweepOnTheBundledWolf) {
   for (const std::string row :
        {"| bdlstm_smoke (1 IF) |", "| bdlstm_smoke (3 IF) |", "| bdlstm_smoke_unidirectional (1 IF) |",
         "| bdlstm_acap_extrapolation (2 IF) |", "| bdlstm_hold (1 IF) |",
+        "| bdlstm_smoke_mesh_vae (2 IF) |",
         "| ACAP floor (true features decoded) |", "| method | wolf 1st | wolf 5th |"}) {
     EXPECT_NE(table.find(row), std::string::npos) << row << "\n" << table;
   }
@@ -520,7 +522,9 @@ TEST(Cli, BdlstmSmokeSweepOnTheBundledWolf) {
     return report["mean"];
   };
   const auto net = mean("bdlstm_smoke"), hold = mean("bdlstm_hold"),
-             extrapolation = mean("bdlstm_acap_extrapolation");
+             extrapolation = mean("bdlstm_acap_extrapolation"), vae = mean("bdlstm_smoke_mesh_vae");
+  EXPECT_EQ(vae["starts5"], hold["starts5"]);
+  EXPECT_GT(vae["e5_2if_mm"].get<double>(), 0);
   EXPECT_TRUE(std::filesystem::exists(results / "bdlstm_smoke" / "bdlstm_smoke_tables" / "best.pt"));
   EXPECT_FALSE(std::filesystem::exists(results / "bdlstm_hold" / "bdlstm_smoke_tables" / "best.pt"));
   // Every method is scored on the same predictions; the floor does not depend on the method.
@@ -546,6 +550,50 @@ TEST(Cli, BdlstmSmokeSweepOnTheBundledWolf) {
   const Result t = run("train configs/bdlstm/hold.yaml data.file=" + data);
   EXPECT_NE(t.status, 0);
   EXPECT_NE(t.err.find("is not trained"), std::string::npos) << t.err;
+
+  // generate: the trained network continues a clip from its held-out window.
+  const std::string smoke_run = (results / "bdlstm_smoke" / "bdlstm_smoke_tables").string();
+  const std::filesystem::path seq = dir / "seq";
+  const Result g = run("generate " + smoke_run + " --init-frames 3 --frames 4 --out " + seq.string());
+  ASSERT_EQ(g.status, 0) << g.err;
+  const auto info = nlohmann::json::parse(read_file(seq / "generate.json"));
+  EXPECT_EQ(info["character"], "wolf");
+  EXPECT_EQ(info["start"], info["held_out_window"][0]);
+  ASSERT_EQ(info["frames"].size(), 4u);
+  for (int t = 0; t < 7; ++t) {  // 3 given + 4 generated frames, each the wolf's mesh
+    const geometry::Mesh frame = geometry::read_obj(seq / fmt::format("frame_{:04d}.obj", t));
+    const geometry::Mesh first = geometry::read_obj(seq / "frame_0000.obj");
+    EXPECT_EQ(frame.V.rows(), first.V.rows());
+    EXPECT_EQ(frame.F, first.F);
+  }
+  EXPECT_FALSE(std::filesystem::exists(seq / "frame_0007.obj"));
+  // The initial frames are the clip's own frames.
+  EXPECT_EQ(geometry::read_obj(seq / "frame_0002.obj").V, geometry::read_obj(seq / "truth_0002.obj").V);
+  EXPECT_GT(info["frames"][0]["error_mm"].get<double>(), 0);
+  EXPECT_TRUE(std::filesystem::exists(seq / "sequence.glb"));
+  EXPECT_TRUE(std::filesystem::exists(seq / "truth.glb"));
+  // An existing directory is not overwritten; a baseline run, a missing clip and initial frames
+  // past the clip's end are clear errors.
+  const std::string before = read_file(seq / "generate.json");
+  const Result again = run("generate " + smoke_run + " --out " + seq.string());
+  EXPECT_NE(again.status, 0);
+  EXPECT_NE(again.err.find("exists"), std::string::npos) << again.err;
+  EXPECT_EQ(read_file(seq / "generate.json"), before);
+  const Result baseline = run("generate " + (results / "bdlstm_hold" / "bdlstm_smoke_tables").string() +
+                              " --out " + (dir / "seq2").string());
+  EXPECT_NE(baseline.status, 0);
+  EXPECT_NE(baseline.err.find("baseline run (hold)"), std::string::npos) << baseline.err;
+  const Result vae_run = run("generate " + (results / "bdlstm_smoke_mesh_vae" / "bdlstm_smoke_tables").string() +
+                             " --out " + (dir / "seq2").string());
+  EXPECT_NE(vae_run.status, 0);
+  EXPECT_NE(vae_run.err.find("mesh_vae run extrapolates"), std::string::npos) << vae_run.err;
+  const Result clip = run("generate " + smoke_run + " --clip nope --out " + (dir / "seq3").string());
+  EXPECT_NE(clip.status, 0);
+  EXPECT_NE(clip.err.find("no clip 'nope' (its clips: "), std::string::npos) << clip.err;
+  const Result late = run("generate " + smoke_run + " --start 100000 --out " + (dir / "seq4").string());
+  EXPECT_NE(late.status, 0);
+  EXPECT_NE(late.err.find("do not fit"), std::string::npos) << late.err;
+  for (const char* name : {"seq2", "seq3", "seq4"}) EXPECT_FALSE(std::filesystem::exists(dir / name));
 }
 
 }  // namespace
