@@ -1,15 +1,26 @@
 /// \file
 /// `skinlab prepare <configs/datasets/<name>.yaml> [key=value ...] [--threads N]
-/// [--keep-partial]`: runs the dataset builders, preprocesses every character (HeterSkinNet
-/// Sec. 4.1) in parallel and writes the one dataset file (framework/data/prepare.hpp).
+/// [--keep-partial] [--nproc N]`: runs the dataset builders, preprocesses every character
+/// (HeterSkinNet Sec. 4.1) in parallel and writes the one dataset file
+/// (framework/data/prepare.hpp).
+///
+/// `--nproc N` shards the characters over N worker processes on this machine (core/launch.hpp),
+/// each writing its characters' partial files, then merges them into the one file. A process
+/// started with WORLD_SIZE > 1 (several nodes sharing the output's file system, with
+/// MASTER_ADDR/MASTER_PORT) prepares shard RANK and waits for the others; rank 0 merges.
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cstdlib>
 #include <iostream>
+#include <thread>
 
 #include "framework/cli/commands.hpp"
 #include "framework/core/config.hpp"
+#include "framework/core/launch.hpp"
 #include "framework/data/prepare.hpp"
+#include "framework/train/distributed.hpp"
 
 namespace skinlab::cli {
 
@@ -19,11 +30,38 @@ struct PrepareArgs {
   std::string file;
   std::vector<std::string> overrides;
   data::PrepareOptions options;
+  int nproc = 0;
 };
 
-int run_prepare(const PrepareArgs& args) {
+int run_prepare(PrepareArgs args) {
   const config::Config config = config::Config::load(args.file, args.overrides);
   const data::PrepareConfig prepare = data::PrepareConfig::from(config);
+  const bool launched = std::getenv("SKINLAB_LAUNCHED") != nullptr;
+  if (args.nproc > 1) {
+    LaunchOptions launch;
+    launch.nproc = args.nproc;
+    launch.args = {"prepare", args.file};
+    launch.args.insert(launch.args.end(), args.overrides.begin(), args.overrides.end());
+    const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+    const int threads = args.options.threads > 0 ? args.options.threads
+                                                 : static_cast<int>(std::max(1u, cores / args.nproc));
+    launch.args.insert(launch.args.end(), {"--threads", std::to_string(threads), "--keep-partial"});
+    launch.environment = {"SKINLAB_LAUNCHED=1"};
+    launch_local(launch);  // each worker prepares its shard
+  } else {
+    train::World world(train::WorldOptions::from_environment());
+    if (world.distributed()) {
+      args.options.shard_index = world.rank();
+      args.options.shard_count = world.size();
+      args.options.progress = args.options.progress && world.writer();
+      data::prepare_dataset(prepare, args.options);
+      if (launched) return 0;  // the launcher merges
+      world.barrier();
+      if (!world.writer()) return 0;
+      args.options.shard_index = 0;
+      args.options.shard_count = 1;
+    }
+  }
   const data::PrepareReport r = data::prepare_dataset(prepare, args.options);
   std::cout << fmt::format(
       "prepared {}: {} characters ({} computed, {} reused), {} excluded, {:.2f} s\n",
@@ -47,6 +85,8 @@ Command add_prepare(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--keep-partial", args->options.keep_partial,
                 "keep <output>.partial/ (per-character files) after the merge");
+  cmd->add_option("--nproc", args->nproc,
+                  "shard the characters over this many processes on this machine, then merge");
   return {cmd, [args] { return run_prepare(*args); }};
 }
 

@@ -1,6 +1,7 @@
 #include "framework/cli/tasks.hpp"
 
 #include "experiments/bdlstm/sequence_table.hpp"
+#include "framework/core/error.hpp"
 
 namespace skinlab::cli {
 
@@ -15,14 +16,25 @@ bool untrained_method(const config::Config& config, const train::RunOptions& opt
   return options.binder.exists();
 }
 
-TaskTrainer::TaskTrainer(const config::Config& config) {
-  const std::string task = train::RunOptions::from(config).task;
+TaskTrainer::TaskTrainer(const config::Config& config, train::World* world) {
+  const train::RunOptions options = train::RunOptions::from(config);
+  const std::string& task = options.task;
+  if (task != "skinning") {
+    if (world != nullptr && world->distributed()) {
+      throw Error(config.source() + ": data-parallel training (--nproc, WORLD_SIZE) is the "
+                  "skinning task's; a " + task + " run trains in one process");
+    }
+    if (options.train.batch != 1) {
+      throw ConfigError(config.source() + ": train.batch (characters per step) is the skinning "
+                        "task's; the " + task + " task has its own batches");
+    }
+  }
   if (task == "corrective") {
     corrective_ = std::make_unique<densegats::CorrectiveTrainer>(config);
   } else if (task == "sequence") {
     sequence_ = std::make_unique<bdlstm::SequenceTrainer>(config);
   } else {
-    skinning_ = std::make_unique<train::Trainer>(config);
+    skinning_ = std::make_unique<train::Trainer>(config, world);
   }
 }
 

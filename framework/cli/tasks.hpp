@@ -25,7 +25,9 @@ bool untrained_method(const config::Config& config, const train::RunOptions& opt
 /// The trainer of the config's task, built (and so validated) before any run directory exists.
 class TaskTrainer {
  public:
-  explicit TaskTrainer(const config::Config& config);
+  /// `world`: the processes of a data-parallel run (nullptr: this one alone); only the skinning
+  /// task trains data-parallel, and only it has `train.batch` (Error otherwise).
+  explicit TaskTrainer(const config::Config& config, train::World* world = nullptr);
   train::TrainResult fit(const RunDir& run, const train::FitLimits& limits = {});
   /// Whether the best checkpoint was selected on validation data (else the train loss).
   bool validated() const;

@@ -1,13 +1,25 @@
 /// \file
-/// `skinlab train <config> [key=value ...] [--resume <run_dir>] [--threads N] [--run-id ID]`:
-/// trains the config's model on the train part of its dataset split (framework/train/), in a new
-/// run directory `<results_dir>/<experiment>/<run_id>/`, or continues the run in `--resume`.
+/// `skinlab train <config> [key=value ...] [--resume <run_dir>] [--threads N] [--run-id ID]
+/// [--nproc N]`: trains the config's model on the train part of its dataset split
+/// (framework/train/), in a new run directory `<results_dir>/<experiment>/<run_id>/`, or
+/// continues the run in `--resume`.
+///
+/// Data parallel (framework/train/distributed.hpp): `--nproc N` creates the run directory and
+/// starts N worker processes on this machine (core/launch.hpp), each `train --resume <run>`
+/// with the launcher's environment; a process started with WORLD_SIZE > 1 in its environment
+/// (by `--nproc`, or by a cluster's job script on several nodes, with MASTER_ADDR/MASTER_PORT)
+/// is one rank of the run. Started by hand, every rank needs the same `--run-id` (or
+/// `--resume`): rank 0 creates the directory, the others wait for it. Only rank 0 logs to the
+/// console at info level and writes the run's files.
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <cstdlib>
 #include <iostream>
 #include <optional>
+#include <thread>
 
 #include "framework/cli/commands.hpp"
 #include "framework/cli/tasks.hpp"
@@ -15,8 +27,10 @@
 #include "framework/core/atomic_file.hpp"
 #include "framework/core/environment.hpp"
 #include "framework/core/error.hpp"
+#include "framework/core/launch.hpp"
 #include "framework/core/logging.hpp"
 #include "framework/core/run_dir.hpp"
+#include "framework/train/distributed.hpp"
 #include "framework/train/trainer.hpp"
 
 namespace skinlab::cli {
@@ -29,7 +43,52 @@ struct TrainArgs {
   std::string resume;
   std::string run_id;
   int threads = -1;
+  int nproc = 0;
 };
+
+/// `--nproc N`: validates the config, creates (or opens) the run, writes its env record with
+/// the world size and runs N workers on it.
+int launch_train(const TrainArgs& args, const std::optional<RunDir>& resumed,
+                 const config::Config& config) {
+  const train::RunOptions options = train::RunOptions::from(config);
+  options.require_training_sections(config);
+  if (options.task != "skinning") {
+    throw Error(config.source() + ": data-parallel training (--nproc) is the skinning task's; a " +
+                options.task + " run trains in one process");
+  }
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const int threads = args.threads > 0 ? args.threads
+                      : args.threads == 0 || options.threads == 0
+                          ? static_cast<int>(std::max(1u, cores / static_cast<unsigned>(args.nproc)))
+                          : options.threads;
+  nlohmann::json env = collect_environment(static_cast<std::uint64_t>(options.seed), command_line());
+  env["world_size"] = args.nproc;
+  env["threads_per_process"] = threads;
+  std::optional<RunDir> run = resumed;
+  if (!run) {
+    run = RunDir::create(options.results_dir, options.experiment, args.run_id);
+    run->write_config(config.to_yaml());
+    run->write_env(env);
+  } else {
+    int n = 1;
+    while (std::filesystem::exists(run->file(fmt::format("env_resume_{}.json", n)))) ++n;
+    write_file_atomic(run->file(fmt::format("env_resume_{}.json", n)), env.dump(2) + "\n");
+  }
+  std::cout << "run: " << run->path().string() << std::endl;
+  LaunchOptions launch;
+  launch.nproc = args.nproc;
+  launch.args = {"train", "--resume", run->path().string(), "--threads", std::to_string(threads)};
+  launch.environment = {"SKINLAB_LAUNCHED=1"};
+  try {
+    launch_local(launch);
+  } catch (const Error& e) {
+    throw Error(std::string(e.what()) + "; continue from its last checkpoint with `skinlab train --resume " +
+                run->path().string() + "` (any --nproc)");
+  }
+  std::cout << "checkpoints: " << run->file(train::kBestCheckpoint).string() << ", "
+            << run->file(train::kLastCheckpoint).string() << "\n";
+  return 0;
+}
 
 int run_train(TrainArgs args) {
   // `train --resume <dir> key=value`: the first assignment lands in the config's position.
@@ -62,33 +121,52 @@ int run_train(TrainArgs args) {
   } else {
     config = config::Config::load(args.file, args.overrides);
   }
+  if (args.nproc > 1) return launch_train(args, run, *config);
   const train::RunOptions options = train::RunOptions::from(*config);
   const int threads = set_torch_threads(args.threads >= 0 ? args.threads : options.threads);
 
+  // One rank of a data-parallel run when WORLD_SIZE > 1 (see the file comment).
+  train::World world(train::WorldOptions::from_environment());
+  const bool launched = std::getenv("SKINLAB_LAUNCHED") != nullptr;
+  if (world.distributed() && !world.writer()) spdlog::set_level(spdlog::level::warn);
+  if (world.distributed() && !run && args.run_id.empty()) {
+    throw Error("train: a rank of a data-parallel run (WORLD_SIZE > 1) needs --run-id or "
+                "--resume, the same for every rank");
+  }
+
   // Everything that can fail on the config, the dataset or the model fails here, before a run
   // directory exists. The config's task decides the trainer.
-  TaskTrainer trainer(*config);
+  TaskTrainer trainer(*config, &world);
   if (!run) {
-    run = train::create_run(*config, options, args.run_id, command_line());
-  } else {
+    if (world.writer()) run = train::create_run(*config, options, args.run_id, command_line());
+    world.barrier();  // the other ranks open what rank 0 created
+    if (!run) run = RunDir::open(std::filesystem::path(options.results_dir) / options.experiment / args.run_id);
+  } else if (world.writer() && !launched) {
     int n = 1;
     while (std::filesystem::exists(run->file(fmt::format("env_resume_{}.json", n)))) ++n;
-    write_file_atomic(run->file(fmt::format("env_resume_{}.json", n)),
-                      collect_environment(static_cast<std::uint64_t>(options.seed), command_line())
-                              .dump(2) + "\n");
+    nlohmann::json env = collect_environment(static_cast<std::uint64_t>(options.seed), command_line());
+    if (world.distributed()) env["world_size"] = world.size();
+    write_file_atomic(run->file(fmt::format("env_resume_{}.json", n)), env.dump(2) + "\n");
   }
-  logging::add_file(run->log_file());
-  std::cout << "run: " << run->path().string() << std::endl;
-  spdlog::info("training {} ({} threads) in {}", options.experiment, threads, run->path().string());
+  if (world.writer()) {
+    logging::add_file(run->log_file());
+    if (!launched) std::cout << "run: " << run->path().string() << std::endl;
+  }
+  spdlog::info("training {} ({} threads{}) in {}", options.experiment, threads,
+               world.distributed() ? fmt::format(" in each of {} processes", world.size()) : "",
+               run->path().string());
 
   const train::TrainResult r = trainer.fit(*run);
+  if (!world.writer()) return 0;
   std::cout << fmt::format(
       "{} {} epochs{} ({} this session, {:.1f} s); best epoch {} with {} loss {:.6g}\n",
       r.early_stopped ? "stopped early after" : "trained", r.epochs,
       r.resumed ? " in total" : "", r.epochs_this_call, r.seconds, r.best_epoch,
       trainer.validated() ? "validation" : "train", r.best_loss);
-  std::cout << "checkpoints: " << run->file(train::kBestCheckpoint).string() << ", "
-            << run->file(train::kLastCheckpoint).string() << "\n";
+  if (!launched) {
+    std::cout << "checkpoints: " << run->file(train::kBestCheckpoint).string() << ", "
+              << run->file(train::kLastCheckpoint).string() << "\n";
+  }
   return 0;
 }
 
@@ -104,6 +182,9 @@ Command add_train(CLI::App& app) {
                   "continue the run in this directory from its last.pt (same config, seed)");
   cmd->add_option("--run-id", args->run_id,
                   "name of the new run directory (default: the UTC time)");
+  cmd->add_option("--nproc", args->nproc,
+                  "train data-parallel in this many processes on this machine (c10d/Gloo); "
+                  "train.batch characters per process and step");
   cmd->add_option("--threads", args->threads,
                   "libtorch threads (default: the config's `threads`; 0 = every core); a "
                   "bit-identical resume needs the same count");

@@ -144,13 +144,25 @@ PrepareReport prepare_dataset(const PrepareConfig& config, const PrepareOptions&
   const std::string commit = git_commit();
 
   const std::size_t n = characters.size();
+  const bool sharded = options.shard_count > 1;
+  if (sharded && (options.shard_index < 0 || options.shard_index >= options.shard_count)) {
+    throw Error("prepare: shard " + std::to_string(options.shard_index) + " of " +
+                std::to_string(options.shard_count) + " does not exist");
+  }
+  const auto mine = [&](std::size_t i) {
+    return !sharded || i % static_cast<std::size_t>(options.shard_count) ==
+                           static_cast<std::size_t>(options.shard_index);
+  };
   std::vector<std::optional<std::string>> failure(n);
   std::vector<char> reused(n, 0);
   std::mutex mutex;
   std::optional<Progress> progress;
-  if (options.progress) progress.emplace("prepare", n);
+  std::size_t share = 0;
+  for (std::size_t i = 0; i < n; ++i) share += mine(i) ? 1 : 0;
+  if (options.progress) progress.emplace("prepare", share);
 
   auto work = [&](std::size_t i) {
+    if (!mine(i)) return;
     const auto& source = characters[i];
     const std::string& name = source.character.name;
     const fs::path file = partial / (name + ".h5");
@@ -173,6 +185,22 @@ PrepareReport prepare_dataset(const PrepareConfig& config, const PrepareOptions&
   };
   arena.execute([&] { tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) { work(i); }); });
   if (progress) progress->finish();
+  if (sharded) {
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!mine(i)) continue;
+      if (failure[i]) {
+        report.excluded.push_back({characters[i].source, characters[i].path, *failure[i]});
+      } else {
+        (reused[i] ? report.reused : report.computed) += 1;
+      }
+    }
+    report.characters = report.computed + report.reused;
+    report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    spdlog::info("shard {} of {}: {} characters into {} ({} computed, {} reused), {} failed, {:.2f} s",
+                 options.shard_index, options.shard_count, report.characters, partial.string(),
+                 report.computed, report.reused, share - report.characters, report.seconds);
+    return report;
+  }
 
   Dataset dataset;
   dataset.git_commit = commit;

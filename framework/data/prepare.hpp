@@ -58,6 +58,13 @@ struct PrepareOptions {
   int threads = 0;            ///< characters (and the TBB work inside them); 0: every core
   bool keep_partial = false;  ///< keep `<output>.partial/` after the merge
   bool progress = true;       ///< report progress on stderr (framework/core/progress.hpp)
+  /// Sharded preparation (`skinlab prepare --nproc N`): with shard_count > 1 this process only
+  /// preprocesses the characters i with i mod shard_count = shard_index (in the cleaned order,
+  /// which every process computes alike) into `<output>.partial/`, and writes no output file.
+  /// A run with shard_count 1 afterwards merges them: every partial file is reused, and only
+  /// what no shard finished (a character that failed is tried again) is computed.
+  int shard_index = 0;
+  int shard_count = 1;
 };
 
 struct PrepareReport {

@@ -104,8 +104,8 @@ void finish_fit(TrainResult& result, const TrainingState& state, const TrainOpti
 
 FitStart start_fit(const RunDir& run, torch::nn::Module& model, torch::optim::Optimizer& optimizer,
                    std::int64_t seed, const std::string& model_config, at::Generator& torch_rng,
-                   at::Generator& order_rng, const torch::Tensor& initial_torch_rng) {
-  remove_stale_temporaries(run);
+                   at::Generator& order_rng, const torch::Tensor& initial_torch_rng, bool writer) {
+  if (writer) remove_stale_temporaries(run);
   FitStart start;
   TrainingState& state = start.state;
   state.seed = seed;
@@ -135,7 +135,7 @@ FitStart start_fit(const RunDir& run, torch::nn::Module& model, torch::optim::Op
   } else {
     set_rng_state(torch_rng, initial_torch_rng);
   }
-  truncate_metrics(run, state.epoch);
+  if (writer) truncate_metrics(run, state.epoch);
   return start;
 }
 

@@ -61,10 +61,12 @@ struct FitStart {
 /// last.pt, loads it into `model` and `optimizer` (Error for another seed than `seed`, a warning
 /// for another thread count), restores both generators and the epoch and best counters and logs
 /// it; otherwise resets `torch_rng` to `initial_torch_rng`. Then drops metrics.jsonl records past
-/// the restored epoch.
+/// the restored epoch. A process that does not write the run (`writer` false: ranks other than 0
+/// of a distributed run) only reads: it neither removes temporaries nor truncates metrics.
 FitStart start_fit(const RunDir& run, torch::nn::Module& model, torch::optim::Optimizer& optimizer,
                    std::int64_t seed, const std::string& model_config, at::Generator& torch_rng,
-                   at::Generator& order_rng, const torch::Tensor& initial_torch_rng);
+                   at::Generator& order_rng, const torch::Tensor& initial_torch_rng,
+                   bool writer = true);
 
 /// The end of a fit: sets `result`'s early_stopped (logging it unless the fit was interrupted),
 /// epochs, best epoch and loss from the final `state`, and the wall time since `start`.

@@ -37,6 +37,7 @@ TrainOptions TrainOptions::from(const config::Node& node) {
   f.optional("max_characters_per_epoch", o.max_characters_per_epoch)
       .check(o.max_characters_per_epoch >= 0, "max_characters_per_epoch",
              "must be ≥ 0 (0 = every training character)");
+  f.optional("batch", o.batch).check(o.batch >= 1, "batch", "must be ≥ 1 character per step");
   f.optional("log_every", o.log_every)
       .check(o.log_every >= 0, "log_every", "must be ≥ 0 (0 = one line per epoch)");
   f.finish();

@@ -65,6 +65,9 @@ struct TrainOptions {
   double min_delta = 0.0;
   /// Train on the first this many characters of each epoch's shuffled order; 0 = all.
   int max_characters_per_epoch = 0;
+  /// Characters per optimiser step in each process: their gradients are averaged (HeterSkinNet
+  /// trains with 1). With N processes (distributed.hpp) a step averages over N × batch.
+  int batch = 1;
   /// A progress line (loss, rate, ETA) every this many steps; 0 = only the per-epoch line.
   int log_every = 100;
 

@@ -7,6 +7,9 @@
 
 #include <chrono>
 #include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
 #include <mutex>
 
 #include "framework/core/environment.hpp"
@@ -60,8 +63,12 @@ RunDir create_run(const config::Config& config, const RunOptions& options,
   return run;
 }
 
-Trainer::Trainer(const config::Config& config)
-    : config_(config), options_(validated(config)), data_(options_.data) {
+Trainer::Trainer(const config::Config& config, World* world)
+    : config_(config), options_(validated(config)), data_(options_.data), world_(world) {
+  if (world_ == nullptr) {
+    alone_ = std::make_unique<World>(WorldOptions{});
+    world_ = alone_.get();
+  }
   if (data_.part("train").empty()) {
     throw IoError(options_.data.file + ": split '" + options_.data.split +
                   "' has no training characters");
@@ -92,20 +99,48 @@ torch::Tensor Trainer::loss_of(const data::CharacterTensors& c, const torch::Ten
   return loss_(in, parts);
 }
 
-double Trainer::step(int index, std::map<std::string, double>& parts) {
-  const data::CharacterTensors& c = data_.tensors(index);
+double Trainer::step(const std::vector<int>& indices, std::size_t step_characters,
+                     std::map<std::string, double>& parts) {
   optimizer_->zero_grad();
-  std::map<std::string, double> step_parts;
-  torch::Tensor loss = loss_of(c, model_->forward(c), &step_parts);
-  const double value = loss.item<double>();
-  if (!std::isfinite(value)) {
-    throw Error(fmt::format("training loss is {} on character '{}' ({}); lower train.lr?", value,
-                            c.name, parts_text(step_parts)));
+  double sum = 0;
+  for (int index : indices) {
+    const data::CharacterTensors& c = data_.tensors(index);
+    std::map<std::string, double> step_parts;
+    torch::Tensor loss = loss_of(c, model_->forward(c), &step_parts);
+    const double value = loss.item<double>();
+    if (!std::isfinite(value)) {
+      throw Error(fmt::format("training loss is {} on character '{}' ({}); lower train.lr?", value,
+                              c.name, parts_text(step_parts)));
+    }
+    loss.backward();
+    sum += value;
+    for (const auto& [name, v] : step_parts) parts[name] += v;
   }
-  loss.backward();
+  world_->sum_gradients(*model_);
+  if (step_characters > 1) {
+    torch::NoGradGuard no_grad;
+    for (auto& p : model_->parameters()) {
+      if (p.grad().defined()) p.mutable_grad().div_(static_cast<double>(step_characters));
+    }
+  }
   optimizer_->step();
-  for (const auto& [name, v] : step_parts) parts[name] += v;
-  return value;
+  return sum;
+}
+
+std::vector<std::string> Trainer::part_names() const {
+  std::vector<std::string> names;
+  for (const auto& term : loss_.terms()) names.push_back(term.name);
+  return names;
+}
+
+double Trainer::world_sum(double value, std::map<std::string, double>& parts, double* count) {
+  std::vector<double> values{value, count ? *count : 0.0};
+  const std::vector<std::string> names = part_names();
+  for (const auto& name : names) values.push_back(parts.count(name) ? parts.at(name) : 0.0);
+  values = world_->sum(values);
+  for (std::size_t i = 0; i < names.size(); ++i) parts[names[i]] = values[i + 2];
+  if (count) *count = values[1];
+  return values[0];
 }
 
 double Trainer::mean_loss(const std::string& part, std::map<std::string, double>* parts) {
@@ -115,12 +150,15 @@ double Trainer::mean_loss(const std::string& part, std::map<std::string, double>
   torch::NoGradGuard no_grad;
   double total = 0;
   std::map<std::string, double> sums;
-  for (int index : indices) {
-    const data::CharacterTensors& c = data_.tensors(index);
+  // Each process scores every N-th character; the sums are added over the world.
+  for (std::size_t i = static_cast<std::size_t>(world_->rank()); i < indices.size();
+       i += static_cast<std::size_t>(world_->size())) {
+    const data::CharacterTensors& c = data_.tensors(indices[i]);
     std::map<std::string, double> p;
     total += loss_of(c, model_->forward(c), &p).item<double>();
     for (const auto& [name, v] : p) sums[name] += v;
   }
+  total = world_sum(total, sums);
   model_->train(was_training);
   const double n = static_cast<double>(std::max<std::size_t>(indices.size(), 1));
   if (parts) {
@@ -140,15 +178,17 @@ TrainResult Trainer::fit(const RunDir& run, const FitLimits& limits) {
   at::Generator torch_rng = at::detail::getDefaultCPUGenerator();
   at::Generator order_rng = at::make_generator<at::CPUGeneratorImpl>(order_seed(options_.seed));
 
+  const bool writer = world_->writer();
   FitStart begun = start_fit(run, *model_, *optimizer_, options_.seed, options_.model.to_yaml(),
-                             torch_rng, order_rng, initial_torch_rng_);
+                             torch_rng, order_rng, initial_torch_rng_, writer);
+  world_->broadcast_parameters(*model_);
   TrainingState& state = begun.state;
   result.resumed = begun.resumed;
   const fs::path last = run.file(kLastCheckpoint);
 
   const std::vector<int>& train = data_.part("train");
   const bool have_val = !data_.part("val").empty();
-  if (!have_val) {
+  if (!have_val && writer) {
     spdlog::warn("split '{}' has no validation characters: best.pt and early stopping use the "
                  "train loss", options_.data.split);
   }
@@ -164,6 +204,15 @@ TrainResult Trainer::fit(const RunDir& run, const FitLimits& limits) {
                  stopped_early() ? ", stopped early" : "");
   }
 
+  // Test hook (tests/cli): SKINLAB_TEST_KILL="<rank>:<steps>" makes that rank kill itself
+  // after <steps> optimiser steps, as a crashed worker would.
+  long kill_after = -1;
+  if (const char* hook = std::getenv("SKINLAB_TEST_KILL")) {
+    int rank = -1;
+    if (std::sscanf(hook, "%d:%ld", &rank, &kill_after) != 2 || rank != world_->rank()) kill_after = -1;
+  }
+  long steps_taken = 0;
+
   model_->train();
   const auto session_start = Clock::now();
   while (state.epoch < t.epochs && !stopped_early()) {
@@ -176,15 +225,29 @@ TrainResult Trainer::fit(const RunDir& run, const FitLimits& limits) {
     double train_sum = 0;
     std::map<std::string, double> train_parts;
     const std::string label = fmt::format("epoch {}/{}", epoch, t.epochs);
-    for (std::size_t s = 0; s < per_epoch; ++s) {
-      train_sum += step(train[static_cast<std::size_t>(order_data[s])], train_parts);
-      if (t.log_every > 0 && (s + 1) % static_cast<std::size_t>(t.log_every) == 0 &&
-          s + 1 < per_epoch) {
+    // A step covers the next `group` characters of the order; this process takes every N-th.
+    const auto N = static_cast<std::size_t>(world_->size());
+    const std::size_t group = N * static_cast<std::size_t>(t.batch);
+    std::size_t logged = 0, done = 0;
+    for (std::size_t g = 0; g < per_epoch; g += group) {
+      const std::size_t end = std::min(per_epoch, g + group);
+      std::vector<int> mine;
+      for (std::size_t s = g + static_cast<std::size_t>(world_->rank()); s < end; s += N) {
+        mine.push_back(train[static_cast<std::size_t>(order_data[s])]);
+      }
+      if (steps_taken++ == kill_after) std::raise(SIGKILL);
+      train_sum += step(mine, end - g, train_parts);
+      done += mine.size();
+      if (t.log_every > 0 && writer && end / static_cast<std::size_t>(t.log_every) > logged &&
+          end < per_epoch) {
+        logged = end / static_cast<std::size_t>(t.log_every);
         const double elapsed = std::chrono::duration<double>(Clock::now() - epoch_start).count();
-        spdlog::info("{} loss {:.5g}", Progress::format(label, s + 1, per_epoch, elapsed),
-                     train_sum / static_cast<double>(s + 1));
+        spdlog::info("{} loss {:.5g}{}", Progress::format(label, end, per_epoch, elapsed),
+                     train_sum / static_cast<double>(std::max<std::size_t>(done, 1)),
+                     N > 1 ? " (rank 0's characters)" : "");
       }
     }
+    train_sum = world_sum(train_sum, train_parts);
     const double n = static_cast<double>(per_epoch);
     const double train_loss = train_sum / n;
     for (auto& [name, v] : train_parts) v /= n;
@@ -210,9 +273,12 @@ TrainResult Trainer::fit(const RunDir& run, const FitLimits& limits) {
                              {"characters", per_epoch},
                              {"lr", t.lr},
                              {"seconds", seconds}};
-    run.append_metrics(record);
-    if (improved) save_checkpoint(run.file(kBestCheckpoint), *model_, optimizer_.get(), state);
-    save_checkpoint(last, *model_, optimizer_.get(), state);
+    if (writer) {
+      if (N > 1) record["world_size"] = N;
+      run.append_metrics(record);
+      if (improved) save_checkpoint(run.file(kBestCheckpoint), *model_, optimizer_.get(), state);
+      save_checkpoint(last, *model_, optimizer_.get(), state);
+    }
     ++result.epochs_this_call;
 
     const double session = std::chrono::duration<double>(Clock::now() - session_start).count();

@@ -20,6 +20,17 @@
 ///
 /// Without a validation part (an empty `val` list) the train loss selects `best.pt` and drives
 /// early stopping, with a warning.
+///
+/// Batches: a step averages the gradients of `train.batch` consecutive characters of the epoch's
+/// order (1 in the paper). Data parallelism (distributed.hpp): in a world of N processes every
+/// process draws the same order, a step covers the next N × batch characters and process r
+/// takes every N-th of them from the r-th; the gradients are summed over the world and divided
+/// by the step's character count, so every process takes the same Adam step. Rank 0 broadcasts
+/// the initial (or resumed) parameters first and is the only one to write metrics and
+/// checkpoints; the validation loss is computed on every N-th character per process and summed.
+/// A run of N processes with batch b therefore follows a one-process run with batch N·b up to
+/// floating-point summation order, for models whose training draws no random numbers (with
+/// dropout each process draws its own masks).
 
 #include <memory>
 #include <string>
@@ -30,6 +41,7 @@
 #include "framework/losses/loss.hpp"
 #include "framework/models/model.hpp"
 #include "framework/train/checkpoint.hpp"
+#include "framework/train/distributed.hpp"
 #include "framework/train/run_data.hpp"
 #include "framework/train/run_options.hpp"
 
@@ -65,7 +77,9 @@ class Trainer {
   /// model, the loss and the optimizer. Throws ConfigError / IoError / RegistryError before any
   /// file is written: an empty train part, a model without parameters and a character lacking
   /// the distance type are errors here.
-  explicit Trainer(const config::Config& config);
+  ///
+  /// `world`: the processes this one trains with (nullptr: alone); it must outlive the Trainer.
+  explicit Trainer(const config::Config& config, World* world = nullptr);
 
   /// Trains in `run` until `train.epochs` epochs or early stopping. If `run` has a `last.pt`,
   /// continues from it (records of later epochs in metrics.jsonl, written by a process killed
@@ -81,13 +95,22 @@ class Trainer {
   double mean_loss(const std::string& part, std::map<std::string, double>* parts = nullptr);
 
  private:
-  double step(int index, std::map<std::string, double>& parts);
+  /// One optimiser step over `indices` (this process's share of the step) when the whole step
+  /// covers `step_characters` characters; returns this process's loss sum.
+  double step(const std::vector<int>& indices, std::size_t step_characters,
+              std::map<std::string, double>& parts);
+  /// The loss terms' names, in a fixed order (for sums over the world).
+  std::vector<std::string> part_names() const;
+  /// `values` summed over the world; `parts` likewise, by part_names().
+  double world_sum(double value, std::map<std::string, double>& parts, double* count = nullptr);
   torch::Tensor loss_of(const data::CharacterTensors& c, const torch::Tensor& pred,
                         std::map<std::string, double>* parts) const;
 
   config::Config config_;
   RunOptions options_;
   RunData data_;
+  World* world_ = nullptr;
+  std::unique_ptr<World> alone_;  ///< the world of one when none is given
   std::shared_ptr<models::Model> model_;
   losses::LossSum loss_;
   std::unique_ptr<torch::optim::Adam> optimizer_;
