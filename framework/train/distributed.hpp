@@ -16,10 +16,10 @@
 ///
 /// `skinlab train --nproc N` (launch.hpp) starts N such processes on this machine.
 ///
-/// What crosses the network per optimiser step: one all-reduce of every gradient, flattened
-/// into one float32 buffer (4 bytes × parameters; HeterSkinNet: 4 × 0.66 M ≈ 2.6 MB), plus one
-/// all-reduce of a few doubles (the step's loss sums and character count). Gloo's ring
-/// all-reduce sends and receives about 2 (N−1)/N of the buffer per process.
+/// What crosses the network per optimiser step: one all-reduce of every gradient, flattened into
+/// one float32 buffer (4 bytes × parameters; HeterSkinNet at the paper's widths: 4 × 4.37 M ≈
+/// 17.5 MB). Gloo's ring all-reduce sends and receives about 2 (N−1)/N of the buffer per
+/// process. Once per epoch a few doubles (loss sums) are added over the world.
 
 #include <torch/torch.h>
 

@@ -84,6 +84,11 @@ Trainer::Trainer(const config::Config& config, World* world)
     options_.model.fail("model '" + options_.model["type"].as<std::string>() +
                         "' has no trainable parameters");
   }
+  std::int64_t count = 0;
+  for (const auto& p : parameters) count += p.numel();
+  spdlog::info("model '{}': {} parameters ({:.1f} MB of float32 gradients per step to all-reduce "
+               "when data-parallel)",
+               options_.model["type"].as<std::string>(), count, 4e-6 * static_cast<double>(count));
   optimizer_ = std::make_unique<torch::optim::Adam>(
       parameters,
       torch::optim::AdamOptions(options_.train.lr).weight_decay(options_.train.weight_decay));
