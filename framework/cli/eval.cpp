@@ -6,9 +6,16 @@
 /// `skinlab eval <config.yaml> [key=value ...] [--split test] [--run-id ID]`: a config with a
 /// `binder:` (weights from geometry alone) needs no training; this creates its run directory
 /// (resolved config, env.json) and evaluates it there.
+///
+/// `--nproc N` shards the characters of a skinning run over N worker processes on this machine
+/// (core/launch.hpp); rank 0 gathers the values and predictions and writes the files. A process
+/// started with WORLD_SIZE > 1 is one rank of such an evaluation (train/distributed.hpp).
 
 #include <fmt/format.h>
 
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 
@@ -19,6 +26,8 @@
 #include "framework/core/run_dir.hpp"
 #include "framework/eval/evaluator.hpp"
 #include "framework/core/error.hpp"
+#include "framework/core/launch.hpp"
+#include "framework/train/distributed.hpp"
 #include "framework/train/run_options.hpp"
 #include "framework/train/trainer.hpp"
 
@@ -32,6 +41,7 @@ struct EvalArgs {
   eval::EvalOptions options;
   bool no_predictions = false;
   int threads = -1;
+  int nproc = 0;
 };
 
 /// The run directory of a binder config (see the file comment); the overrides are applied to the
@@ -64,6 +74,28 @@ int run_eval(EvalArgs args) {
                 " is not a config file");
   }
   const RunDir run = from_config ? create_binder_run(args) : RunDir::open(args.run);
+  if (args.nproc > 1) {
+    const config::Config config = config::Config::load(run.file("config.yaml"), args.options.overrides);
+    const std::string task = train::RunOptions::from(config).task;
+    if (task != "skinning") {
+      throw Error(run.path().string() + ": sharded evaluation (--nproc) is the skinning task's; a " +
+                  task + " run is evaluated in one process");
+    }
+    LaunchOptions launch;
+    launch.nproc = args.nproc;
+    launch.args = {"eval", run.path().string(), "--split", args.options.part, "--checkpoint",
+                   args.options.checkpoint, "--threads", std::to_string(std::max(args.threads, 1))};
+    launch.args.insert(launch.args.end(), args.options.overrides.begin(), args.options.overrides.end());
+    if (args.no_predictions) launch.args.push_back("--no-predictions");
+    launch.environment = {"SKINLAB_LAUNCHED=1"};
+    launch_local(launch);
+    return 0;
+  }
+  train::World world(train::WorldOptions::from_environment());
+  if (world.distributed()) {
+    args.options.world = &world;
+    if (!world.writer()) spdlog::set_level(spdlog::level::warn);
+  }
   if (args.threads >= 0) {
     set_torch_threads(args.threads);
   } else {
@@ -72,6 +104,7 @@ int run_eval(EvalArgs args) {
   }
   args.options.predictions = !args.no_predictions;
   const eval::EvalReport r = evaluate_run(run, args.options);
+  if (!world.writer()) return 0;
   std::cout << fmt::format("{} part of split '{}', {} characters, checkpoint {} (epoch {}), {:.1f} s\n",
                            r.part, r.split, r.characters.size(), r.checkpoint, r.epoch, r.seconds);
   for (const auto& [name, value] : r.mean) std::cout << fmt::format("  {}: {:.6g}\n", name, value);
@@ -99,6 +132,8 @@ Command add_eval(CLI::App& app) {
   cmd->add_option("--checkpoint", args->options.checkpoint, "best or last")->capture_default_str();
   cmd->add_flag("--no-predictions", args->no_predictions,
                 "do not write predictions/ (rig text and HDF5)");
+  cmd->add_option("--nproc", args->nproc,
+                  "shard the characters over this many processes on this machine (skinning runs)");
   cmd->add_option("--threads", args->threads,
                   "libtorch threads (default: the run config's `threads`; 0 = every core)");
   return {cmd, [args] { return run_eval(*args); }};

@@ -53,6 +53,10 @@ bool TaskTrainer::validated() const {
 eval::EvalReport evaluate_run(const RunDir& run, const eval::EvalOptions& options) {
   const config::Config config = config::Config::load(run.file("config.yaml"), options.overrides);
   const std::string task = train::RunOptions::from(config).task;
+  if (task != "skinning" && options.world != nullptr && options.world->distributed()) {
+    throw Error(run.path().string() + ": sharded evaluation is the skinning task's; a " + task +
+                " run is evaluated in one process");
+  }
   if (task == "corrective") return densegats::evaluate_corrective(run, options);
   if (task == "sequence") return bdlstm::evaluate_sequence(run, options);
   return eval::evaluate(run, options);

@@ -126,13 +126,14 @@ int run_train(TrainArgs args) {
   const int threads = set_torch_threads(args.threads >= 0 ? args.threads : options.threads);
 
   // One rank of a data-parallel run when WORLD_SIZE > 1 (see the file comment).
-  train::World world(train::WorldOptions::from_environment());
-  const bool launched = std::getenv("SKINLAB_LAUNCHED") != nullptr;
-  if (world.distributed() && !world.writer()) spdlog::set_level(spdlog::level::warn);
-  if (world.distributed() && !run && args.run_id.empty()) {
+  const train::WorldOptions world_options = train::WorldOptions::from_environment();
+  if (world_options.distributed() && !run && args.run_id.empty()) {
     throw Error("train: a rank of a data-parallel run (WORLD_SIZE > 1) needs --run-id or "
                 "--resume, the same for every rank");
   }
+  train::World world(world_options);
+  const bool launched = std::getenv("SKINLAB_LAUNCHED") != nullptr;
+  if (world.distributed() && !world.writer()) spdlog::set_level(spdlog::level::warn);
 
   // Everything that can fail on the config, the dataset or the model fails here, before a run
   // directory exists. The config's task decides the trainer.

@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <set>
+#include <sstream>
 
 #include "framework/binders/binder.hpp"
 #include "framework/core/atomic_file.hpp"
@@ -19,6 +20,7 @@
 #include "framework/losses/loss.hpp"
 #include "framework/models/model.hpp"
 #include "framework/train/checkpoint.hpp"
+#include "framework/train/distributed.hpp"
 #include "framework/train/run_data.hpp"
 #include "framework/train/trainer.hpp"
 
@@ -186,15 +188,28 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
   std::unique_ptr<PredictionFile> h5;
   const fs::path predictions = run.file("predictions");
   const fs::path rig_dir = predictions / options.part;
-  if (options.predictions) {
+  const bool writer = options.world == nullptr || options.world->writer();
+  if (options.predictions && writer) {
     fs::create_directories(rig_dir);
     report.predictions = predictions;
     h5 = std::make_unique<PredictionFile>(predictions / (options.part + ".h5"));
   }
 
+  const auto write_prediction = [&](const data::PreparedCharacter& character,
+                                    const torch::Tensor& candidates, const torch::Tensor& weights) {
+    const data::RowMatrixXf source = to_source_vertices(to_eigen(weights), character.vertex_map);
+    write_rig_prediction(rig_dir / (character.name + "_rig.txt"), character, source);
+    h5->add(character, o.data.distance, candidates, weights, source);
+  };
   torch::NoGradGuard no_grad;
-  Progress progress("eval " + options.part, indices.size());
-  for (int index : indices) {
+  // With several processes, this one evaluates positions rank, rank + N, ... of the part.
+  const std::size_t N = options.world ? static_cast<std::size_t>(options.world->size()) : 1;
+  const std::size_t rank = options.world ? static_cast<std::size_t>(options.world->rank()) : 0;
+  Progress progress("eval " + options.part, (indices.size() + N - 1 - rank) / N);
+  std::vector<CharacterResult> mine;
+  std::vector<torch::Tensor> predicted;  // candidates and bone weights of each of mine
+  for (std::size_t i = rank; i < indices.size(); i += N) {
+    const int index = indices[i];
     const data::PreparedCharacter& character =
         data.dataset().characters[static_cast<std::size_t>(index)];
     const data::CharacterTensors& c = data.tensors(index);
@@ -226,16 +241,52 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
     for (const auto& metric : metrics) {
       for (const auto& [name, value] : (*metric)(mi)) r.values[name] = value;
     }
-    report.characters.push_back(std::move(r));
-
-    if (h5) {
-      const data::RowMatrixXf source = to_source_vertices(to_eigen(weights), character.vertex_map);
-      write_rig_prediction(rig_dir / (character.name + "_rig.txt"), character, source);
-      h5->add(character, o.data.distance, candidates, weights, source);
+    mine.push_back(std::move(r));
+    if (options.predictions && N == 1) {
+      write_prediction(character, candidates, weights);
+    } else if (options.predictions) {
+      predicted.insert(predicted.end(), {candidates, weights});
     }
     progress.tick();
   }
   progress.finish();
+  if (N > 1) {
+    // Rank 0 gathers every process's values (JSON) and predictions (torch-serialised tensors).
+    nlohmann::json values = nlohmann::json::array();
+    for (const auto& r : mine) {
+      values.push_back({{"name", r.name}, {"vertices", r.vertices}, {"bones", r.bones}, {"values", r.values}});
+    }
+    std::ostringstream tensors;
+    if (options.predictions) torch::save(predicted, tensors);
+    const auto all_values = options.world->gather("eval-values", values.dump(), true);
+    const auto all_tensors = options.world->gather("eval-predictions", tensors.str(), true);
+    if (!options.world->writer()) return report;
+    std::vector<std::vector<CharacterResult>> by_rank(N);
+    std::vector<std::vector<torch::Tensor>> tensors_by_rank(N);
+    for (std::size_t q = 0; q < N; ++q) {
+      for (const auto& v : nlohmann::json::parse(all_values[q])) {
+        CharacterResult r;
+        r.name = v["name"].get<std::string>();
+        r.vertices = v["vertices"].get<int>();
+        r.bones = v["bones"].get<int>();
+        r.values = v["values"].get<std::map<std::string, double>>();
+        by_rank[q].push_back(std::move(r));
+      }
+      if (options.predictions) {
+        std::istringstream in(all_tensors[q]);
+        torch::load(tensors_by_rank[q], in);
+      }
+    }
+    mine.clear();
+    for (std::size_t i = 0; i < indices.size(); ++i) {
+      mine.push_back(std::move(by_rank[i % N][i / N]));
+      if (h5) {
+        write_prediction(data.dataset().characters[static_cast<std::size_t>(indices[i])],
+                         tensors_by_rank[i % N][2 * (i / N)], tensors_by_rank[i % N][2 * (i / N) + 1]);
+      }
+    }
+  }
+  report.characters = std::move(mine);
   report.mean = mean_values(report.characters);
 
   if (h5) {

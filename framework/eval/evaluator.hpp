@@ -27,6 +27,10 @@
 
 #include "framework/core/run_dir.hpp"
 
+namespace skinlab::train {
+class World;
+}  // namespace skinlab::train
+
 namespace skinlab::eval {
 
 struct EvalOptions {
@@ -35,6 +39,10 @@ struct EvalOptions {
   bool predictions = true;            ///< write predictions/ (rig text and HDF5)
   /// Applied to the run's config.yaml, e.g. `data.file=...` when the dataset has moved.
   std::vector<std::string> overrides;
+  /// Sharded evaluation (`skinlab eval --nproc N`, train/distributed.hpp): process r evaluates
+  /// every N-th character of the part from the r-th; rank 0 gathers their values and
+  /// predictions and writes every file, the others return an empty report. nullptr: alone.
+  train::World* world = nullptr;
 };
 
 struct CharacterResult {
@@ -63,7 +71,7 @@ std::map<std::string, double> mean_values(const std::vector<CharacterResult>& ch
 /// so `skinlab table` reads them alike.
 void write_eval_files(const RunDir& run, EvalReport& report, nlohmann::json header);
 
-/// Evaluates `run` (see the file comment). Throws Error/IoError/ConfigError for: an unknown part
+/// Evaluates `run` (see the file comment; EvalOptions::world for several processes). Throws Error/IoError/ConfigError for: an unknown part
 /// or checkpoint name, a missing checkpoint, a checkpoint that does not match the model of the
 /// config, a missing dataset or split, an empty part.
 EvalReport evaluate(const RunDir& run, const EvalOptions& options);

@@ -142,14 +142,15 @@ std::vector<double> World::sum(const std::vector<double>& values) {
   return {t.data_ptr<double>(), t.data_ptr<double>() + t.numel()};
 }
 
-std::vector<std::string> World::gather(const std::string& key, const std::string& text) {
+std::vector<std::string> World::gather(const std::string& key, const std::string& text,
+                                      bool root_only) {
   if (!distributed()) return {text};
   const std::string prefix = fmt::format("gather/{}/{}/", group_->gathers++, key);
   std::vector<std::string> out;
   try {
     group_->store->set(prefix + std::to_string(options_.rank),
                        std::vector<std::uint8_t>(text.begin(), text.end()));
-    for (int r = 0; r < options_.size; ++r) {
+    for (int r = 0; r < options_.size && !(root_only && !writer()); ++r) {
       const std::vector<std::uint8_t> bytes = group_->store->get(prefix + std::to_string(r));
       out.emplace_back(bytes.begin(), bytes.end());
     }

@@ -70,8 +70,10 @@ class World {
   void sum_gradients(torch::nn::Module& module);
   /// Element-wise sums over the world (float64).
   std::vector<double> sum(const std::vector<double>& values);
-  /// Every process's `text`, in rank order (through the store).
-  std::vector<std::string> gather(const std::string& key, const std::string& text);
+  /// Every process's `text` (any bytes), in rank order, through the store. With `root_only`,
+  /// only rank 0 receives them (the others get an empty list).
+  std::vector<std::string> gather(const std::string& key, const std::string& text,
+                                  bool root_only = false);
   /// Waits for every process.
   void barrier();
 

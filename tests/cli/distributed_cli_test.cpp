@@ -6,13 +6,17 @@
 
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
+#include <thread>
 #include <nlohmann/json.hpp>
 
 #include "framework/core/atomic_file.hpp"
 #include "framework/core/config.hpp"
+#include "framework/core/launch.hpp"
 #include "framework/data/dataset_file.hpp"
 #include "framework/train/checkpoint.hpp"
 #include "framework/train/run_options.hpp"
@@ -113,8 +117,54 @@ TEST_F(Distributed, TwoProcessesFollowOneProcessWithTheSameEffectiveBatch) {
     largest = std::max(largest, (p1[i] - p2[i]).abs().max().item<double>());
   }
   EXPECT_LT(largest, 1e-5) << "largest parameter difference";
-  // And the steps did something: the parameters moved from their initialisation.
-  EXPECT_GT(metrics_of(run_dir("one")).front()["train_loss"].get<double>(), 0);
+
+  // Sharded evaluation: two processes score every character of the part as one does, and rank 0
+  // writes the same files.
+  const Result e1 = run("eval " + run_dir("one").string() + " --split test --threads 1");
+  ASSERT_EQ(e1.status, 0) << e1.err;
+  const auto single = nlohmann::json::parse(read_file(run_dir("one") / "eval_test.json"));
+  const std::string rig = read_file(run_dir("one") / "predictions" / "test" /
+                                    (single["per_character"][0]["character"].get<std::string>() + "_rig.txt"));
+  const Result e2 = run("eval " + run_dir("one").string() + " --split test --nproc 2 --threads 1");
+  ASSERT_EQ(e2.status, 0) << e2.err;
+  const auto sharded = nlohmann::json::parse(read_file(run_dir("one") / "eval_test.json"));
+  ASSERT_EQ(sharded["per_character"].size(), single["per_character"].size());
+  for (std::size_t i = 0; i < single["per_character"].size(); ++i) {
+    EXPECT_EQ(sharded["per_character"][i], single["per_character"][i]) << i;
+  }
+  EXPECT_EQ(sharded["mean"], single["mean"]);
+  EXPECT_EQ(read_file(run_dir("one") / "predictions" / "test" /
+                      (single["per_character"][0]["character"].get<std::string>() + "_rig.txt")),
+            rig);
+}
+
+// Ranks started by hand with PyTorch's launcher environment (as a cluster job script starts one
+// process per node) train the same run as `--nproc`.
+TEST_F(Distributed, RanksStartedByHandWithTheLaunchersEnvironment) {
+  const Result two = run(train_args("train.batch=1 --nproc 2 --run-id by-launcher"));
+  ASSERT_EQ(two.status, 0) << two.err;
+  const std::string env = fmt::format("WORLD_SIZE=2 MASTER_ADDR=127.0.0.1 MASTER_PORT={}", free_local_port());
+  const std::string cli = std::string("'") + SKINLAB_CLI + "' ";
+  const std::string args = train_args("train.batch=1 --run-id by-hand");
+  const std::string command = std::string("cd '") + SKINLAB_SOURCE_DIR + "' && (" + env + " RANK=1 " +
+                              cli + args + " > /dev/null 2>&1 &) && " + env + " RANK=0 " + cli + args +
+                              " > /dev/null 2>&1";
+  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  for (int tries = 0; tries < 100 && metrics_of(run_dir("by-hand")).size() < 2; ++tries) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  const auto metrics = metrics_of(run_dir("by-hand"));
+  ASSERT_EQ(metrics.size(), 2u);
+  EXPECT_EQ(metrics.back()["world_size"], 2);
+  const auto p = parameters_of(run_dir("by-hand"), "last.pt"), q = parameters_of(run_dir("by-launcher"), "last.pt");
+  ASSERT_EQ(p.size(), q.size());
+  for (std::size_t i = 0; i < p.size(); ++i) EXPECT_TRUE(p[i].equal(q[i])) << "parameter " << i;
+  // Without a shared run id the ranks could not find one run directory: an error at once.
+  ::setenv("WORLD_SIZE", "2", 1);
+  const Result no_id = run(train_args(""));
+  ::unsetenv("WORLD_SIZE");
+  EXPECT_NE(no_id.status, 0);
+  EXPECT_NE(no_id.err.find("needs --run-id or --resume"), std::string::npos) << no_id.err;
 }
 
 TEST_F(Distributed, ADeadWorkerStopsTheRunAndItResumesInAnotherWorldSize) {
