@@ -198,16 +198,17 @@ SequenceData::SequenceData(const SequenceOptions& options) : options_(options), 
   }
   for (const fs::path& dir : selected) {
     const std::string name = dir.filename().string();
-    const std::vector<fs::path> clips = entries(dir);
+    std::vector<std::pair<fs::path, std::vector<fs::path>>> clips;  // clip folder, its frames
+    for (const fs::path& clip : entries(dir)) clips.emplace_back(clip, entries(clip, ".obj"));
     fs::path rest_file = dir / "template.obj";
     if (!fs::exists(rest_file)) {
       const auto first = std::find_if(clips.begin(), clips.end(),
-                                      [](const fs::path& c) { return !entries(c, ".obj").empty(); });
+                                      [](const auto& clip) { return !clip.second.empty(); });
       if (first == clips.end()) {
         excluded_.push_back(name + ": no clip folder with .obj frames");
         continue;
       }
-      rest_file = entries(*first, ".obj").front();
+      rest_file = first->second.front();
     }
     geometry::Character rest;
     rest.name = name;
@@ -219,8 +220,7 @@ SequenceData::SequenceData(const SequenceOptions& options) : options_(options), 
     out.rest = rest.mesh;
     out.acap = std::make_shared<const geometry::AcapEncoder>(out.rest, rest_file.string());
     out.one_ring = data::to_long(data::RowMatrixXi(geometry::one_ring(out.rest).edges.transpose()));
-    for (const fs::path& clip : clips) {
-      const std::vector<fs::path> files = entries(clip, ".obj");
+    for (const auto& [clip, files] : clips) {
       MeshSequence s;
       s.clip = clip.filename().string();
       for (std::size_t f = 0; f < files.size(); f += static_cast<std::size_t>(options.frame_stride)) {

@@ -10,8 +10,6 @@
 #include <filesystem>
 #include <limits>
 
-#include <unistd.h>
-
 #include "framework/core/atomic_file.hpp"
 #include "framework/core/environment.hpp"
 #include "framework/core/error.hpp"
@@ -70,6 +68,13 @@ std::vector<Eigen::MatrixXd> training_frames(const SequenceCharacter& c) {
     }
   }
   return out;
+}
+
+/// L_2 of Eq. 3: Σ w² over every trainable parameter of `module`.
+torch::Tensor squared_weights(torch::nn::Module& module) {
+  torch::Tensor l2 = torch::zeros({});
+  for (const auto& p : module.parameters()) l2 = l2 + p.pow(2).sum();
+  return l2;
 }
 
 /// The sequences of a config: its `sequences.folder` of OBJ sequences, else its dataset file.
@@ -159,8 +164,7 @@ torch::Tensor vae_loss(MeshVae& vae, const torch::Tensor& frames, const Objectiv
   torch::Tensor kl;
   const torch::Tensor recon =
       (vae.reconstruct(frames, &kl) - frames).reshape({frames.size(0), -1}).norm(2, 1).mean();
-  torch::Tensor l2 = torch::zeros({});
-  for (const auto& p : vae.parameters()) l2 = l2 + p.pow(2).sum();
+  const torch::Tensor l2 = squared_weights(vae);
   if (parts) {
     (*parts)["recon"] += recon.item<double>();
     (*parts)["kl"] += kl.item<double>();
@@ -189,8 +193,7 @@ torch::Tensor sequence_loss(SequenceNet& net, const Rollout& rollout,
   if (!rollout.backward.empty()) {
     for (std::size_t i = 0; i < L; ++i) bidir = bidir + norm(rollout.forward[i] - rollout.backward[L - 1 - i]);
   }
-  torch::Tensor l2 = torch::zeros({});
-  for (const auto& p : net.parameters()) l2 = l2 + p.pow(2).sum();
+  const torch::Tensor l2 = squared_weights(net);
   const torch::Tensor total = objective.recon * recon + objective.bidir * bidir +
                               objective.kl * rollout.kl + objective.l2 * l2;
   if (parts) {
@@ -383,11 +386,7 @@ eval::EvalReport evaluate_sequence(const RunDir& run, const eval::EvalOptions& o
   if (!c.has_data) throw ConfigError(config.source() + ": evaluating " + kNeedsData);
   fs::path checkpoint;
   if (baseline.empty()) {
-    checkpoint = train::checkpoint_file(run.path(), options.checkpoint);
-    if (!fs::exists(checkpoint)) {
-      throw IoError(checkpoint.string() + ": no checkpoint '" + options.checkpoint +
-                    "' in this run (a run writes best.pt and last.pt after its first epoch)");
-    }
+    checkpoint = train::existing_checkpoint(run.path(), options.checkpoint);
   }
   const std::unique_ptr<SequenceData> data = make_data(c);
   eval::EvalReport report;
@@ -522,10 +521,7 @@ GeneratedSequence generate_sequence(const RunDir& run, const GenerateOptions& op
                                               : "is a baseline run (" + c.sequences.baseline + ")") +
                 "; generate needs a trained bdlstm run");
   }
-  const fs::path checkpoint = train::checkpoint_file(run.path(), options.checkpoint);
-  if (!fs::exists(checkpoint)) {
-    throw IoError(checkpoint.string() + ": no checkpoint '" + options.checkpoint + "' in this run");
-  }
+  const fs::path checkpoint = train::existing_checkpoint(run.path(), options.checkpoint);
   const std::unique_ptr<SequenceData> data = make_data(c);
   const SequenceCharacter& ch = data->characters().front();
   const ScaledCharacter scaled = scale_character(ch);
@@ -585,19 +581,13 @@ GeneratedSequence generate_sequence(const RunDir& run, const GenerateOptions& op
     per_frame.push_back(entry);
   }
 
-  // Everything goes into a temporary sibling directory, renamed to `out` at the end.
-  const fs::path parent = out.parent_path().empty() ? fs::path(".") : out.parent_path();
-  fs::create_directories(parent);
-  const fs::path temp = parent / fmt::format(".{}.tmp-{}", out.filename().string(), ::getpid());
-  fs::remove_all(temp);
-  fs::create_directories(temp);
-  try {
-    const double fps = options.fps > 0 ? options.fps : (q.fps > 0 ? q.fps : 30.0);
+  const double fps = options.fps > 0 ? options.fps : (q.fps > 0 ? q.fps : 30.0);
+  write_directory_atomic(out, [&](const fs::path& staging) {
     const auto write_frames = [&](const std::string& stem, const std::vector<Eigen::MatrixXd>& list) {
       for (std::size_t t = 0; t < list.size(); ++t) {
-        geometry::write_obj(temp / fmt::format("{}_{:04d}.obj", stem, t), geometry::Mesh{list[t], ch.rest.F});
+        geometry::write_obj(staging / fmt::format("{}_{:04d}.obj", stem, t), geometry::Mesh{list[t], ch.rest.F});
       }
-      geometry::write_gltf_morph_animation(temp / (stem == "frame" ? "sequence.glb" : "truth.glb"),
+      geometry::write_gltf_morph_animation(staging / (stem == "frame" ? "sequence.glb" : "truth.glb"),
                                            ch.name + "/" + q.clip, ch.rest.F, list, fps);
     };
     write_frames("frame", frames);
@@ -620,14 +610,8 @@ GeneratedSequence generate_sequence(const RunDir& run, const GenerateOptions& op
          "their centroids in the last initial frame); truth_0000..: the clip over the same span; "
          "error_mm scores a generated frame as Table 1 does (parts at their true centroids), mm "
          "with the character 1 m tall"}};
-    write_file_atomic(temp / "generate.json", info.dump(2) + "\n");
-    if (fs::exists(out)) fs::remove(out);  // an empty directory (checked above)
-    fs::rename(temp, out);
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove_all(temp, ignored);
-    throw;
-  }
+    write_file_atomic(staging / "generate.json", info.dump(2) + "\n");
+  });
   return result;
 }
 

@@ -306,11 +306,7 @@ eval::EvalReport evaluate_corrective(const RunDir& run, const eval::EvalOptions&
   fs::path checkpoint;
   if (baseline.empty()) {
     c.run.require_training_sections(config);
-    checkpoint = train::checkpoint_file(run.path(), options.checkpoint);
-    if (!fs::exists(checkpoint)) {
-      throw IoError(checkpoint.string() + ": no checkpoint '" + options.checkpoint +
-                    "' in this run (a run writes best.pt and last.pt after its first epoch)");
-    }
+    checkpoint = train::existing_checkpoint(run.path(), options.checkpoint);
   } else if (!c.run.data_node.exists()) {
     throw ConfigError(config.source() + ": evaluating a config needs a 'data' section");
   }

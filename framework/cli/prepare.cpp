@@ -11,10 +11,8 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
 #include <cstdlib>
 #include <iostream>
-#include <thread>
 
 #include "framework/cli/commands.hpp"
 #include "framework/core/config.hpp"
@@ -42,25 +40,21 @@ int run_prepare(PrepareArgs args) {
     launch.nproc = args.nproc;
     launch.args = {"prepare", args.file};
     launch.args.insert(launch.args.end(), args.overrides.begin(), args.overrides.end());
-    const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
-    const int threads = args.options.threads > 0 ? args.options.threads
-                                                 : static_cast<int>(std::max(1u, cores / args.nproc));
+    const int threads = threads_per_worker(args.options.threads, args.nproc);
     launch.args.insert(launch.args.end(), {"--threads", std::to_string(threads), "--keep-partial"});
     launch.environment = {"SKINLAB_LAUNCHED=1"};
     launch_local(launch);  // each worker prepares its shard
-  } else {
-    train::World world(train::WorldOptions::from_environment());
-    if (world.distributed()) {
-      args.options.shard_index = world.rank();
-      args.options.shard_count = world.size();
-      args.options.progress = args.options.progress && world.writer();
-      data::prepare_dataset(prepare, args.options);
-      if (launched) return 0;  // the launcher merges
-      world.barrier();
-      if (!world.writer()) return 0;
-      args.options.shard_index = 0;
-      args.options.shard_count = 1;
-    }
+  } else if (const train::WorldOptions w = train::WorldOptions::from_environment(); w.distributed()) {
+    args.options.shard_index = w.rank;
+    args.options.shard_count = w.size;
+    args.options.progress = args.options.progress && w.rank == 0;
+    data::prepare_dataset(prepare, args.options);
+    if (launched) return 0;  // the launcher merges; no process group needed
+    train::World world(w);
+    world.barrier();
+    if (!world.writer()) return 0;
+    args.options.shard_index = 0;
+    args.options.shard_count = 1;
   }
   const data::PrepareReport r = data::prepare_dataset(prepare, args.options);
   std::cout << fmt::format(

@@ -15,11 +15,9 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include <algorithm>
 #include <cstdlib>
 #include <iostream>
 #include <optional>
-#include <thread>
 
 #include "framework/cli/commands.hpp"
 #include "framework/cli/tasks.hpp"
@@ -56,11 +54,7 @@ int launch_train(const TrainArgs& args, const std::optional<RunDir>& resumed,
     throw Error(config.source() + ": data-parallel training (--nproc) is the skinning task's; a " +
                 options.task + " run trains in one process");
   }
-  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
-  const int threads = args.threads > 0 ? args.threads
-                      : args.threads == 0 || options.threads == 0
-                          ? static_cast<int>(std::max(1u, cores / static_cast<unsigned>(args.nproc)))
-                          : options.threads;
+  const int threads = threads_per_worker(args.threads >= 0 ? args.threads : options.threads, args.nproc);
   nlohmann::json env = collect_environment(static_cast<std::uint64_t>(options.seed), command_line());
   env["world_size"] = args.nproc;
   env["threads_per_process"] = threads;

@@ -73,6 +73,22 @@ void write_file_atomic(const fs::path& target, std::string_view contents) {
   out.commit();
 }
 
+void write_directory_atomic(const fs::path& target,
+                            const std::function<void(const fs::path& staging)>& write) {
+  fs::path staging = target;
+  staging += ".partial";
+  fs::remove_all(staging);
+  fs::create_directories(staging);
+  try {
+    write(staging);
+    fs::rename(staging, target);  // POSIX rename replaces an empty directory
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove_all(staging, ignored);
+    throw;
+  }
+}
+
 std::string read_file(const fs::path& path) {
   std::ifstream file(path, std::ios::binary);
   if (!file) fail(path, "cannot open for reading");

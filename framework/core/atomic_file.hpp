@@ -5,6 +5,7 @@
 /// file or the new one under the target name, never a half-written file.
 
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <string_view>
 
@@ -37,6 +38,13 @@ class AtomicPath {
 
 /// Writes `contents` to `target` atomically. Throws IoError naming `target` on failure.
 void write_file_atomic(const std::filesystem::path& target, std::string_view contents);
+
+/// Builds the directory `target` whole: `write` fills a staging directory `<target>.partial`
+/// (created empty, replacing any left-over one), which is renamed to `target` when `write`
+/// returns. If `write` throws, the staging directory is removed and `target` is untouched.
+/// `target` must not exist, or be an empty directory (the caller checks which it allows).
+void write_directory_atomic(const std::filesystem::path& target,
+                            const std::function<void(const std::filesystem::path& staging)>& write);
 
 /// Reads a whole file. Throws IoError naming `path` on failure.
 std::string read_file(const std::filesystem::path& path);

@@ -24,6 +24,10 @@ struct LaunchOptions {
   std::vector<std::string> environment;
 };
 
+/// Threads for each of `nproc` workers: `requested` when it is positive, else (0: every core)
+/// this machine's cores shared out, at least 1.
+int threads_per_worker(int requested, int nproc);
+
 /// A TCP port on 127.0.0.1 that was free a moment ago (bound to port 0 and released).
 int free_local_port();
 

@@ -148,12 +148,9 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
   if (is_binder) {
     o.require_binder_sections(config);
   } else {
-    checkpoint = train::checkpoint_file(run.path(), options.checkpoint);
+    train::checkpoint_file(run.path(), options.checkpoint);  // an unknown name is reported first
     o.require_training_sections(config);
-    if (!fs::exists(checkpoint)) {
-      throw IoError(checkpoint.string() + ": no checkpoint '" + options.checkpoint +
-                    "' in this run (a run writes best.pt and last.pt after its first epoch)");
-    }
+    checkpoint = train::existing_checkpoint(run.path(), options.checkpoint);
   }
 
   train::RunData data(o.data);

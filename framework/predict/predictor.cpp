@@ -262,11 +262,7 @@ void bundle(const fs::path& run_dir, const fs::path& out, const std::string& che
   const std::shared_ptr<models::Model> model = train::build_model(options);
   const train::TrainingState state = train::load_checkpoint(weights, *model);
 
-  fs::path staging = out;
-  staging += ".partial";
-  fs::remove_all(staging);
-  fs::create_directories(staging);
-  try {
+  write_directory_atomic(out, [&](const fs::path& staging) {
     fs::copy_file(config_file, staging / "config.yaml");
     write_file_atomic(staging / "preparation.yaml", preparation);
     train::TrainingState kept = state;  // without the RNG states: nothing resumes a bundle
@@ -284,12 +280,7 @@ void bundle(const fs::path& run_dir, const fs::path& out, const std::string& che
     write_file_atomic(staging / "source.txt",
                       fmt::format("run: {}\ncheckpoint: {}.pt\nepoch: {}\n", run_dir.string(),
                                   checkpoint, state.epoch));
-    fs::rename(staging, out);
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove_all(staging, ignored);
-    throw;
-  }
+  });
 }
 
 }  // namespace skinlab::predict

@@ -21,6 +21,16 @@ std::filesystem::path checkpoint_file(const std::filesystem::path& run_dir,
   return run_dir / (which + ".pt");
 }
 
+std::filesystem::path existing_checkpoint(const std::filesystem::path& run_dir,
+                                          const std::string& which) {
+  std::filesystem::path file = checkpoint_file(run_dir, which);
+  if (!std::filesystem::exists(file)) {
+    throw IoError(file.string() + ": no checkpoint '" + which +
+                  "' in this run (a run writes best.pt and last.pt after its first epoch)");
+  }
+  return file;
+}
+
 namespace fs = std::filesystem;
 
 namespace {

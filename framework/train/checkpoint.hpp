@@ -52,6 +52,11 @@ void check_checkpointable(const torch::nn::Module& model);
 std::filesystem::path checkpoint_file(const std::filesystem::path& run_dir,
                                       const std::string& which);
 
+/// checkpoint_file, and it must exist: IoError "<path>: no checkpoint '<which>' in this run ..."
+/// otherwise (what evaluating or generating from a run needs).
+std::filesystem::path existing_checkpoint(const std::filesystem::path& run_dir,
+                                          const std::string& which);
+
 /// Writes `path` atomically. `optimizer` may be null (then no optimizer state is stored).
 void save_checkpoint(const std::filesystem::path& path, const torch::nn::Module& model,
                      const torch::optim::Optimizer* optimizer, const TrainingState& state);

@@ -138,13 +138,12 @@ std::vector<std::string> Trainer::part_names() const {
   return names;
 }
 
-double Trainer::world_sum(double value, std::map<std::string, double>& parts, double* count) {
-  std::vector<double> values{value, count ? *count : 0.0};
+double Trainer::world_sum(double value, std::map<std::string, double>& parts) {
+  std::vector<double> values{value};
   const std::vector<std::string> names = part_names();
   for (const auto& name : names) values.push_back(parts.count(name) ? parts.at(name) : 0.0);
   values = world_->sum(values);
-  for (std::size_t i = 0; i < names.size(); ++i) parts[names[i]] = values[i + 2];
-  if (count) *count = values[1];
+  for (std::size_t i = 0; i < names.size(); ++i) parts[names[i]] = values[i + 1];
   return values[0];
 }
 

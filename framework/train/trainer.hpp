@@ -101,8 +101,8 @@ class Trainer {
               std::map<std::string, double>& parts);
   /// The loss terms' names, in a fixed order (for sums over the world).
   std::vector<std::string> part_names() const;
-  /// `values` summed over the world; `parts` likewise, by part_names().
-  double world_sum(double value, std::map<std::string, double>& parts, double* count = nullptr);
+  /// `value` summed over the world; `parts` likewise, by part_names().
+  double world_sum(double value, std::map<std::string, double>& parts);
   torch::Tensor loss_of(const data::CharacterTensors& c, const torch::Tensor& pred,
                         std::map<std::string, double>* parts) const;
 
