@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "datasets/source.hpp"
+#include "framework/data/source.hpp"
 #include "framework/geometry/skin_weights.hpp"
 
 namespace skinlab::datasets {

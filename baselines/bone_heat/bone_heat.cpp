@@ -34,7 +34,7 @@ using TriangleIterator = std::vector<Triangle>::const_iterator;
 using Primitive = CGAL::AABB_triangle_primitive<Kernel, TriangleIterator>;
 using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>>;
 
-const char* const kOwner = "binder 'bone_heat'";
+const char* const kBoneHeatOwner = "binder 'bone_heat'";
 constexpr double kDistanceEpsilon = 1e-4;  // Blender DISTANCE_EPSILON (relative tie tolerance)
 constexpr double kMinDistance = 1e-4;      // Blender: mindist = max(mindist, 1e-4)
 constexpr double kRayShrink = 1e-5;        // Blender: ray starts 1e-5 along, ends 1e-5 short
@@ -62,7 +62,7 @@ std::uint64_t edge_key(int a, int b) {
 
 BoneHeat::Options BoneHeat::Options::from(const config::Node& node) {
   Options o;
-  config::Fields f(node, kOwner);
+  config::Fields f(node, kBoneHeatOwner);
   f.optional("heat_constant", o.heat_constant)
       .check(std::isfinite(o.heat_constant) && o.heat_constant > 0, "heat_constant",
              "must be positive");
@@ -86,8 +86,8 @@ BoneHeat::Options BoneHeat::Options::from(const config::Node& node) {
 
 Eigen::MatrixXd BoneHeat::bind(const geometry::Mesh& input, const geometry::Skeleton& skeleton,
                                BoneHeatStats* stats) const {
-  input.validate(kOwner);
-  skeleton.validate(kOwner);
+  input.validate(kBoneHeatOwner);
+  skeleton.validate(kBoneHeatOwner);
   BoneHeatStats local_stats;
   BoneHeatStats& st = stats ? *stats : local_stats;
   st = {};
@@ -288,12 +288,12 @@ Eigen::MatrixXd BoneHeat::bind(const geometry::Mesh& input, const geometry::Skel
     A.setFromTriplets(reduced.begin(), reduced.end());
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(A);
     if (solver.info() != Eigen::Success) {
-      throw GeometryError(std::string(kOwner) + ": the heat system (" + std::to_string(na) +
+      throw GeometryError(std::string(kBoneHeatOwner) + ": the heat system (" + std::to_string(na) +
                           " vertices) could not be factorised");
     }
     const Eigen::MatrixXd solution = solver.solve(rhs);
     if (solver.info() != Eigen::Success || !solution.allFinite()) {
-      throw GeometryError(std::string(kOwner) + ": the heat system (" + std::to_string(na) +
+      throw GeometryError(std::string(kBoneHeatOwner) + ": the heat system (" + std::to_string(na) +
                           " vertices) has no finite solution");
     }
     for (int r = 0; r < na; ++r) W.row(active[r]) = solution.row(r);
@@ -327,7 +327,7 @@ Eigen::MatrixXd BoneHeat::bind(const geometry::Mesh& input, const geometry::Skel
     }
     const double sum = W.row(v).sum();
     if (!(sum > 0) || !std::isfinite(sum)) {
-      throw GeometryError(std::string(kOwner) + ": vertex " + std::to_string(v) +
+      throw GeometryError(std::string(kBoneHeatOwner) + ": vertex " + std::to_string(v) +
                           " has no positive bone weight");
     }
     W.row(v) /= sum;

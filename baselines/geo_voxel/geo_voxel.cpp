@@ -24,7 +24,7 @@ namespace {
 using geometry::GeometryError;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-const char* const kOwner = "binder 'geo_voxel'";
+const char* const kGeoVoxelOwner = "binder 'geo_voxel'";
 
 /// Offsets, in cells, of the ray lines from the cell centres along the two axes across a line:
 /// irrational-looking multiples of 1e-4 so that no line meets a vertex or edge of a test mesh
@@ -168,7 +168,7 @@ std::vector<VoxelState> solid_voxels(const geometry::Mesh& mesh,
 
 GeoVoxel::Options GeoVoxel::Options::from(const config::Node& node) {
   Options o;
-  config::Fields f(node, kOwner);
+  config::Fields f(node, kGeoVoxelOwner);
   f.optional("resolution", o.resolution)
       .check(o.resolution >= 8, "resolution", "must be at least 8")
       .check(o.resolution <= 1024, "resolution", "must be at most 1024");
@@ -185,8 +185,8 @@ GeoVoxel::Options GeoVoxel::Options::from(const config::Node& node) {
 Eigen::MatrixXd GeoVoxel::distances(const geometry::Mesh& input,
                                     const geometry::Skeleton& skeleton,
                                     GeoVoxelStats* stats) const {
-  input.validate(kOwner);
-  skeleton.validate(kOwner);
+  input.validate(kGeoVoxelOwner);
+  skeleton.validate(kGeoVoxelOwner);
   geometry::OrientReport orient;
   const geometry::Mesh mesh =
       options_.orient_outward ? geometry::orient_outward(input, &orient) : input;
@@ -314,7 +314,7 @@ Eigen::MatrixXd GeoVoxel::bind(const geometry::Mesh& mesh, const geometry::Skele
       sum += W(v, b);
     }
     if (!(sum > 0) || !std::isfinite(sum)) {
-      throw GeometryError(std::string(kOwner) + ": vertex " + std::to_string(v) +
+      throw GeometryError(std::string(kGeoVoxelOwner) + ": vertex " + std::to_string(v) +
                           " has no finite bone weight");
     }
     W.row(v) /= sum;

@@ -7,7 +7,7 @@ namespace skinlab::baselines {
 namespace {
 
 // The widths of NeuroSkinning's Fig. 3, for any of `stem`, `local`, `global` a config leaves out.
-constexpr const char* kDefaults = R"(
+constexpr const char* kNeuroSkinningDefaults = R"(
 stem:
   - {type: gconv_pool, mlp: [256]}
 local:
@@ -26,7 +26,7 @@ NeuroSkinning::Options NeuroSkinning::Options::from(const config::Node& node) {
   f.optional("input_mlp", o.input_mlp);
   for (auto w : o.input_mlp) f.check(w >= 1, "input_mlp", "widths must be ≥ 1");
   f.finish();
-  o.fill_missing_branches(kDefaults);
+  o.fill_missing_branches(kNeuroSkinningDefaults);
   return o;
 }
 

@@ -9,7 +9,7 @@ namespace {
 // RigNet's widths (models/SKINNING.py l. 32–35; GCU(in → out): edge MLPs [out/2, out/2], fusing
 // MLP [out], models/gcn_basic_modules.py l. 51–55), for any of `stem`, `local`, `global` that a
 // config leaves out.
-constexpr const char* kDefaults = R"(
+constexpr const char* kRigNetDefaults = R"(
 stem:
   - {type: mesh_conv, edges: [one_ring, geodesic], edge_mlp: [256, 256], mlp: [512]}
 local:
@@ -28,7 +28,7 @@ RigNetSkin::Options RigNetSkin::Options::from(const config::Node& node) {
   f.optional("input_mlp", o.input_mlp);
   for (auto w : o.input_mlp) f.check(w >= 1, "input_mlp", "widths must be ≥ 1");
   f.finish();
-  o.fill_missing_branches(kDefaults);
+  o.fill_missing_branches(kRigNetDefaults);
   return o;
 }
 

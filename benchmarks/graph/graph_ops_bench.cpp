@@ -22,6 +22,7 @@
 #include <fstream>
 #include <string>
 
+#include "framework/tensors/threads.hpp"
 #include "framework/core/config.hpp"
 #include "framework/core/environment.hpp"
 #include "framework/core/registry.hpp"

@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "datasets/source.hpp"
+#include "framework/data/source.hpp"
 #include "framework/core/config.hpp"
 
 namespace skinlab::datasets {

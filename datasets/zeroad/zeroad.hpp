@@ -24,7 +24,7 @@
 
 #include <string>
 
-#include "datasets/source.hpp"
+#include "framework/data/source.hpp"
 #include "framework/core/config.hpp"
 
 namespace skinlab::datasets {

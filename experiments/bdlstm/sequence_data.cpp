@@ -9,7 +9,7 @@
 #include <filesystem>
 
 #include "framework/core/error.hpp"
-#include "framework/data/tensors.hpp"
+#include "framework/tensors/tensors.hpp"
 #include "framework/geometry/lbs.hpp"
 #include "framework/geometry/normalize.hpp"
 #include "framework/geometry/obj_io.hpp"

@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// Mesh sequences for the share-weight bidirectional LSTM (Qiao et al., "Synthesizing Mesh
-/// Deformation Sequences with Bidirectional LSTM"; issue 10): fixed-connectivity sequences and
+/// Deformation Sequences with Bidirectional LSTM"): fixed-connectivity sequences and
 /// their ACAP features (Sec. 3.1, framework/geometry/acap.hpp), with a held-out subsequence of
 /// each for testing (Sec. 4.1).
 ///

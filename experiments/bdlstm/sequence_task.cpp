@@ -120,7 +120,7 @@ SequenceConfig SequenceConfig::from(const config::Config& config) {
     throw ConfigError(config.source() + ": task is '" + c.run.task +
                       "'; the mesh-sequence task needs `task: sequence`");
   }
-  c.sequences = SequenceTaskOptions::from(c.run.sequences);
+  c.sequences = SequenceTaskOptions::from(c.run.task_section);
   c.has_data = !c.sequences.data.folder.empty() || c.run.data_node.exists();
   if (c.run.model.exists()) {
     c.model_type = sequence_model_type(c.run.model);
@@ -134,7 +134,7 @@ SequenceConfig SequenceConfig::from(const config::Config& config) {
                        "evaluate, not both");
     }
     if (c.sequences.data.characters.size() != 1) {
-      c.run.sequences.fail("a bdlstm network belongs to one mesh (its fully connected layers are "
+      c.run.task_section.fail("a bdlstm network belongs to one mesh (its fully connected layers are "
                            "sized by it; Sec. 3.2): set sequences.characters to one name");
     }
   }

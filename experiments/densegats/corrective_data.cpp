@@ -7,7 +7,7 @@
 #include <map>
 
 #include "framework/core/error.hpp"
-#include "framework/data/tensors.hpp"
+#include "framework/tensors/tensors.hpp"
 #include "framework/geometry/lbs.hpp"
 #include "framework/geometry/orient_outward.hpp"
 #include "framework/geometry/vertex_normals.hpp"

@@ -9,7 +9,7 @@
 ///               Euclidean distances to all J posed joints;
 ///     target  : Delta Mush(LBS mesh) − LBS mesh, per vertex, in cm at the character's height.
 ///
-/// Our data, honestly (issue 9). The paper's ground truth is artist-refined deformation of ~150
+/// Our data, honestly. The paper's ground truth is artist-refined deformation of ~150
 /// characters sharing a 65-joint skeleton; it is private. Ours: the 0 A.D. humans, dozens of
 /// garment variants on one 46-joint biped skeleton, with the artist's own weights, posed by the
 /// game's own animation clips (art/animation/biped/**.psa), and as the non-linear target

@@ -60,13 +60,6 @@ FigureRun open_run(const std::string& dir, const std::string& part) {
 
 }  // namespace
 
-bool is_corrective_run(const fs::path& run_dir) {
-  const fs::path file = run_dir / "config.yaml";
-  if (!fs::exists(file)) return false;
-  const config::Node task = config::Config::load(file).root()["task"];
-  return task.exists() && task.as<std::string>() == "corrective";
-}
-
 void write_corrective_figures(const std::vector<std::string>& run_dirs,
                               const CorrectiveFigureOptions& options) {
   if (run_dirs.empty()) throw Error("corrective figures: no run given");

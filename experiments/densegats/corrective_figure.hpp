@@ -37,8 +37,6 @@ struct CorrectiveFigureOptions {
   std::string command;                  ///< the command line, for the README
 };
 
-/// True when `run_dir`'s config.yaml has `task: corrective`.
-bool is_corrective_run(const std::filesystem::path& run_dir);
 
 /// Writes `<out>/<character>_pose<index>.png` per character and pose, one vertex-coloured PLY
 /// per run, character and pose under `<out>/<experiment>/`, and `<out>/README.md` (captions,

@@ -18,6 +18,7 @@
 #include "framework/geometry/dqs.hpp"
 #include "framework/train/checkpoint.hpp"
 #include "framework/train/fit_support.hpp"
+#include "framework/eval/value_display.hpp"
 
 namespace skinlab::densegats {
 
@@ -95,7 +96,7 @@ CorrectiveConfig CorrectiveConfig::from(const config::Config& config) {
     throw ConfigError(config.source() + ": task is '" + c.run.task +
                       "'; the corrective-deformation task needs `task: corrective`");
   }
-  c.corrective = CorrectiveOptions::from(c.run.corrective);
+  c.corrective = CorrectiveOptions::from(c.run.task_section);
   if (!c.corrective.baseline.empty() && c.run.model.exists()) {
     c.run.model.fail("a corrective config has a 'model' to train or a 'corrective.baseline' "
                      "deformer to evaluate, not both");
@@ -439,3 +440,8 @@ eval::EvalReport evaluate_corrective(const RunDir& run, const eval::EvalOptions&
 }
 
 }  // namespace skinlab::densegats
+
+// DenseGATs Table 3's values: vertex error over the evaluation poses, in cm.
+SKINLAB_DECLARE_VALUE({"mean_error_cm", "Mean err.", "cm", false, false, 4});
+SKINLAB_DECLARE_VALUE({"max_error_cm", "Max err.", "cm", false, false, 4});
+SKINLAB_DECLARE_VALUE({"min_error_cm", "Min err.", "cm", false, false, 4});

@@ -8,7 +8,7 @@ namespace {
 
 // NeuroSkinning's Fig. 3 widths, as configs/baselines/neuroskinning.yaml; used for any branch a
 // config leaves out. The graph has no bone nodes here, so only vertices are pooled.
-constexpr const char* kDefaults = R"(
+constexpr const char* kCorrectiveNeuroSkinningDefaults = R"(
 stem:
   - {type: gconv_pool, mlp: [256]}
 global: {type: global_pool, pool: [vertex], vertex_mlp: [1024], to: [vertex], keep_input: false}
@@ -27,7 +27,7 @@ NeuroSkinningCorrective::Options NeuroSkinningCorrective::Options::from(const co
   f.optional("input_mlp", o.input_mlp);
   graph::check_widths(f, "input_mlp", o.input_mlp, true);
   f.finish();
-  o.fill_missing_branches(kDefaults);
+  o.fill_missing_branches(kCorrectiveNeuroSkinningDefaults);
   return o;
 }
 

@@ -8,7 +8,7 @@ namespace {
 
 // The paper's architecture (Sec. 3.3, 4.2) as config text, used for any of `stem`, `local`,
 // `global` that a config leaves out.
-constexpr const char* kDefaults = R"(
+constexpr const char* kHeterSkinNetDefaults = R"(
 stem:
   - {type: b2v, mlp: [256]}
   - {type: v2b, mlp: [128]}
@@ -34,7 +34,7 @@ HeterSkinNet::Options HeterSkinNet::Options::from(const config::Node& node) {
   o.read(f);
   o.edge_dropout = graph::EdgeDropoutOptions::from(f.section("edge_dropout"));
   f.finish();
-  o.fill_missing_branches(kDefaults);
+  o.fill_missing_branches(kHeterSkinNetDefaults);
   return o;
 }
 

@@ -33,7 +33,8 @@ Command add_predict(CLI::App& app);
 Command add_bundle(CLI::App& app);
 Command add_export(CLI::App& app);
 Command add_score(CLI::App& app);
-Command add_generate(CLI::App& app);
+/// Every task's own subcommands (framework/task/task.hpp, Task::commands).
+std::vector<Command> add_task_commands(CLI::App& app);
 
 /// The command line `skinlab` was started with (recorded in a run's env.json).
 const std::vector<std::string>& command_line();

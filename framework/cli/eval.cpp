@@ -19,8 +19,9 @@
 #include <filesystem>
 #include <iostream>
 
+#include "framework/tensors/threads.hpp"
 #include "framework/cli/commands.hpp"
-#include "framework/cli/tasks.hpp"
+#include "framework/task/task.hpp"
 #include "framework/core/config.hpp"
 #include "framework/core/environment.hpp"
 #include "framework/core/run_dir.hpp"
@@ -53,14 +54,8 @@ RunDir create_binder_run(EvalArgs& args) {
     throw Error(args.run + ": has a 'model', which must be trained first: `skinlab train " +
                 args.run + "`, then `skinlab eval <its run directory>`");
   }
-  if (!untrained_method(config, o)) {
-    if (o.task == "sequence" || o.task == "corrective") {
-      throw ConfigError(args.run + ": a " + o.task + " config needs a 'model' (trained first) or a '" +
-                        (o.task == "sequence" ? "sequences" : "corrective") +
-                        ".baseline' to evaluate");
-    }
-    o.require_binder_sections(config);  // names what an evaluated config needs
-  }
+  const task::Task& task = task::get(o.task);
+  if (!task.untrained(config, o)) task.require_untrained_sections(config, o);
   args.options.overrides.clear();
   RunDir run = train::create_run(config, o, args.run_id, command_line());
   std::cout << "run: " << run.path().string() << "\n";
@@ -76,11 +71,8 @@ int run_eval(EvalArgs args) {
   const RunDir run = from_config ? create_binder_run(args) : RunDir::open(args.run);
   if (args.nproc > 1) {
     const config::Config config = config::Config::load(run.file("config.yaml"), args.options.overrides);
-    const std::string task = train::RunOptions::from(config).task;
-    if (task != "skinning") {
-      throw Error(run.path().string() + ": sharded evaluation (--nproc) is the skinning task's; a " +
-                  task + " run is evaluated in one process");
-    }
+    task::require_data_parallel(task::of(config), run.path().string(), "sharded evaluation (--nproc)",
+                                "is evaluated in one process");
     LaunchOptions launch;
     launch.nproc = args.nproc;
     launch.args = {"eval", run.path().string(), "--split", args.options.part, "--checkpoint",
@@ -103,7 +95,7 @@ int run_eval(EvalArgs args) {
     set_torch_threads(train::RunOptions::from(config).threads);
   }
   args.options.predictions = !args.no_predictions;
-  const eval::EvalReport r = evaluate_run(run, args.options);
+  const eval::EvalReport r = task::evaluate_run(run, args.options);
   if (!world.writer()) return 0;
   std::cout << fmt::format("{} part of split '{}', {} characters, checkpoint {} (epoch {}), {:.1f} s\n",
                            r.part, r.split, r.characters.size(), r.checkpoint, r.epoch, r.seconds);

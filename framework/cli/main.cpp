@@ -10,15 +10,14 @@
 #include <string>
 #include <vector>
 
+#include "framework/tensors/threads.hpp"
 #include "framework/core/config.hpp"
 #include "framework/core/environment.hpp"
 #include "framework/core/error.hpp"
 #include "framework/core/logging.hpp"
 #include "framework/core/registry.hpp"
-#include "experiments/bdlstm/sequence_task.hpp"
-#include "experiments/densegats/corrective_task.hpp"
 #include "framework/cli/commands.hpp"
-#include "framework/train/run_options.hpp"
+#include "framework/task/task.hpp"
 
 namespace skinlab::cli {
 
@@ -82,9 +81,7 @@ Command add_config(CLI::App& app) {
   return {cmd, [file, overrides] {
             const config::Config config = config::Config::load(*file, *overrides);
             // Validates every section before printing (the tasks' own sections too).
-            const std::string task = train::RunOptions::from(config).task;
-            if (task == "corrective") densegats::CorrectiveConfig::from(config);
-            if (task == "sequence") bdlstm::SequenceConfig::from(config);
+            task::of(config).validate(config);
             std::cout << config.to_yaml();
             return 0;
           }};
@@ -104,7 +101,7 @@ int main(int argc, char** argv) {
   app.add_option("--threads", threads, "libtorch threads; 0 = every hardware thread")
       ->capture_default_str();
 
-  const std::vector<skinlab::cli::Command> commands = {
+  std::vector<skinlab::cli::Command> commands = {
       skinlab::cli::add_info(app), skinlab::cli::add_config(app),
       skinlab::cli::add_distance(app), skinlab::cli::add_prepare(app),
       skinlab::cli::add_dataset_info(app), skinlab::cli::add_dataset_card(app),
@@ -112,7 +109,14 @@ int main(int argc, char** argv) {
       skinlab::cli::add_table(app), skinlab::cli::add_curves(app), skinlab::cli::add_figure(app),
       skinlab::cli::add_sweep(app), skinlab::cli::add_predict(app),
       skinlab::cli::add_bundle(app), skinlab::cli::add_export(app),
-      skinlab::cli::add_score(app), skinlab::cli::add_generate(app)};
+      skinlab::cli::add_score(app)};
+  try {  // the tasks' own commands: building the tasks can fail on a bad registration
+    skinlab::verify_registries();
+    for (auto& command : skinlab::cli::add_task_commands(app)) commands.push_back(std::move(command));
+  } catch (const std::exception& e) {
+    std::cerr << "skinlab: error: " << e.what() << "\n";
+    return 1;
+  }
 
   try {
     app.parse(argc, argv);

@@ -31,8 +31,9 @@
 #include <map>
 #include <optional>
 
+#include "framework/tensors/threads.hpp"
 #include "framework/cli/commands.hpp"
-#include "framework/cli/tasks.hpp"
+#include "framework/task/task.hpp"
 #include "framework/core/atomic_file.hpp"
 #include "framework/core/config.hpp"
 #include "framework/core/environment.hpp"
@@ -108,7 +109,7 @@ fs::path run_entry(const Sweep& sweep, const Entry& entry, int threads) {
       e.part = sweep.part;
       e.predictions = sweep.predictions;
       if (threads >= 0) set_torch_threads(threads);
-      evaluate_run(run, e);
+      task::evaluate_run(run, e);
     }
     return run.path();
   }
@@ -116,7 +117,7 @@ fs::path run_entry(const Sweep& sweep, const Entry& entry, int threads) {
   overrides.insert(overrides.end(), entry.overrides.begin(), entry.overrides.end());
   const config::Config config = config::Config::load(entry.config, overrides);
   const train::RunOptions o = train::RunOptions::from(config);
-  const bool binder = untrained_method(config, o);
+  const bool binder = task::get(o.task).untrained(config, o);
   if (!binder) o.require_training_sections(config);
   set_torch_threads(threads >= 0 ? threads : o.threads);
 
@@ -149,9 +150,9 @@ fs::path run_entry(const Sweep& sweep, const Entry& entry, int threads) {
                            dir.string());
   std::optional<RunDir> run;
   if (!binder) {
-    TaskTrainer trainer(config);
+    const std::unique_ptr<task::TaskTrainer> trainer = task::make_trainer(config);
     run = existed ? RunDir::open(dir) : train::create_run(config, o, run_id, command_line());
-    const train::TrainResult r = trainer.fit(*run);
+    const train::TrainResult r = trainer->fit(*run, {});
     spdlog::info("{}: {} epochs, best epoch {} (validation loss {:.6g})", o.experiment, r.epochs,
                  r.best_epoch, r.best_loss);
   } else {
@@ -160,7 +161,7 @@ fs::path run_entry(const Sweep& sweep, const Entry& entry, int threads) {
   eval::EvalOptions e;
   e.part = sweep.part;
   e.predictions = sweep.predictions;
-  const eval::EvalReport report = evaluate_run(*run, e);
+  const eval::EvalReport report = task::evaluate_run(*run, e);
   std::cout << fmt::format("   {} characters, {:.1f} s\n", report.characters.size(), report.seconds);
   return run->path();
 }
@@ -209,12 +210,12 @@ Command add_sweep(CLI::App& app) {
             t.metrics = sweep.metrics;
             t.title = sweep.title;
             t.command = "skinlab sweep " + args->file;
-            const std::string md = table_text(results, t);
+            const std::string md = task::table_text(results, t);
             t.format = "csv";
             const fs::path out = sweep.out;
             if (out.has_parent_path()) fs::create_directories(out.parent_path());
             write_file_atomic(out, md);
-            write_file_atomic(fs::path(out).replace_extension(".csv"), table_text(results, t));
+            write_file_atomic(fs::path(out).replace_extension(".csv"), task::table_text(results, t));
             std::cout << md << "wrote " << out.string() << "\n";
             return 0;
           }};

@@ -7,7 +7,7 @@
 #include <iostream>
 
 #include "framework/cli/commands.hpp"
-#include "framework/cli/tasks.hpp"
+#include "framework/task/task.hpp"
 #include "framework/core/atomic_file.hpp"
 #include "framework/report/table.hpp"
 
@@ -43,7 +43,7 @@ Command add_table(CLI::App& app) {
             }
             command = "skinlab" + command;
             args->options.command = command;
-            const std::string text = table_text(runs, args->options);
+            const std::string text = task::table_text(runs, args->options);
             if (args->out.empty()) {
               std::cout << text;
             } else {

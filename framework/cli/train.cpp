@@ -19,8 +19,9 @@
 #include <iostream>
 #include <optional>
 
+#include "framework/tensors/threads.hpp"
 #include "framework/cli/commands.hpp"
-#include "framework/cli/tasks.hpp"
+#include "framework/task/task.hpp"
 #include "framework/core/config.hpp"
 #include "framework/core/atomic_file.hpp"
 #include "framework/core/environment.hpp"
@@ -50,10 +51,8 @@ int launch_train(const TrainArgs& args, const std::optional<RunDir>& resumed,
                  const config::Config& config) {
   const train::RunOptions options = train::RunOptions::from(config);
   options.require_training_sections(config);
-  if (options.task != "skinning") {
-    throw Error(config.source() + ": data-parallel training (--nproc) is the skinning task's; a " +
-                options.task + " run trains in one process");
-  }
+  task::require_data_parallel(task::get(options.task), config.source(),
+                              "data-parallel training (--nproc)", "trains in one process");
   const int threads = threads_per_worker(args.threads >= 0 ? args.threads : options.threads, args.nproc);
   nlohmann::json env = collect_environment(static_cast<std::uint64_t>(options.seed), command_line());
   env["world_size"] = args.nproc;
@@ -131,7 +130,7 @@ int run_train(TrainArgs args) {
 
   // Everything that can fail on the config, the dataset or the model fails here, before a run
   // directory exists. The config's task decides the trainer.
-  TaskTrainer trainer(*config, &world);
+  const std::unique_ptr<task::TaskTrainer> trainer = task::make_trainer(*config, &world);
   if (!run) {
     if (world.writer()) run = train::create_run(*config, options, args.run_id, command_line());
     world.barrier();  // the other ranks open what rank 0 created
@@ -151,13 +150,13 @@ int run_train(TrainArgs args) {
                world.distributed() ? fmt::format(" in each of {} processes", world.size()) : "",
                run->path().string());
 
-  const train::TrainResult r = trainer.fit(*run);
+  const train::TrainResult r = trainer->fit(*run, {});
   if (!world.writer()) return 0;
   std::cout << fmt::format(
       "{} {} epochs{} ({} this session, {:.1f} s); best epoch {} with {} loss {:.6g}\n",
       r.early_stopped ? "stopped early after" : "trained", r.epochs,
       r.resumed ? " in total" : "", r.epochs_this_call, r.seconds, r.best_epoch,
-      trainer.validated() ? "validation" : "train", r.best_loss);
+      trainer->validated() ? "validation" : "train", r.best_loss);
   if (!launched) {
     std::cout << "checkpoints: " << run->file(train::kBestCheckpoint).string() << ", "
               << run->file(train::kLastCheckpoint).string() << "\n";

@@ -2,7 +2,7 @@
 /// \file
 /// The config layer: YAML files with `_base_:` inheritance, command-line overrides and typed
 /// decoding into per-plug-in options structs. It is the only code that touches `YAML::Node`
-/// (ARCHITECTURE.md, "Seams worth keeping"); everything else sees `config::Node`.
+/// so that everything else sees `config::Node`.
 ///
 /// Semantics (as in mmengine/detectron2):
 /// - `_base_: file.yaml` or `_base_: [a.yaml, b.yaml]`: paths relative to the including file;

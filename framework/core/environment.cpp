@@ -1,12 +1,10 @@
 #include "framework/core/environment.hpp"
 
-#include <ATen/Parallel.h>
 #include <CGAL/version.h>
 #include <H5public.h>
 #include <malloc.h>
 #include <fmt/core.h>
 #include <spdlog/version.h>
-#include <torch/version.h>
 #include <unistd.h>
 
 #include <Eigen/Core>
@@ -16,7 +14,7 @@
 #include <ctime>
 #include <fstream>
 #include <memory>
-#include <thread>
+#include <utility>
 
 #include "framework/core/error.hpp"
 
@@ -30,6 +28,11 @@
 namespace skinlab {
 
 namespace {
+
+ComputeRuntime& compute_runtime() {
+  static ComputeRuntime runtime;
+  return runtime;
+}
 
 /// Runs a shell command and returns its stdout, or nullopt-like empty + ok=false on failure.
 bool run_capture(const std::string& command, std::string& out) {
@@ -83,10 +86,11 @@ GitState git_state(const std::filesystem::path& dir) {
   return state;
 }
 
+void register_compute_runtime(ComputeRuntime runtime) { compute_runtime() = std::move(runtime); }
+
 nlohmann::json library_versions() {
-  return {
+  nlohmann::json versions = {
       {"compiler", "g++ " __VERSION__},
-      {"libtorch", TORCH_VERSION},
       {"eigen", fmt::format("{}.{}.{}", EIGEN_WORLD_VERSION, EIGEN_MAJOR_VERSION,
                             EIGEN_MINOR_VERSION)},
       {"cgal", CGAL_VERSION_STR},
@@ -98,6 +102,8 @@ nlohmann::json library_versions() {
                                     NLOHMANN_JSON_VERSION_MINOR, NLOHMANN_JSON_VERSION_PATCH)},
       {"blas", loaded_library("libblas.so.3")},
   };
+  if (!compute_runtime().name.empty()) versions[compute_runtime().name] = compute_runtime().version;
+  return versions;
 }
 
 void keep_freed_memory() {
@@ -114,15 +120,6 @@ double peak_memory_mib() {
   return 0.0;
 }
 
-int torch_threads() { return at::get_num_threads(); }
-
-int set_torch_threads(int n) {
-  if (n < 0) throw Error("thread count must be >= 0 (0 = every hardware thread), got " + std::to_string(n));
-  const int hardware = static_cast<int>(std::thread::hardware_concurrency());
-  at::set_num_threads(n > 0 ? n : std::max(1, hardware));
-  return at::get_num_threads();
-}
-
 nlohmann::json collect_environment(std::uint64_t seed, const std::vector<std::string>& command) {
   const GitState git = git_state(source_dir());
   std::array<char, 256> host{};
@@ -137,7 +134,7 @@ nlohmann::json collect_environment(std::uint64_t seed, const std::vector<std::st
       {"git_dirty", git.dirty},
       {"build_type", SKINLAB_BUILD_TYPE},
       {"libraries", library_versions()},
-      {"threads", torch_threads()},
+      {"threads", compute_runtime().threads ? compute_runtime().threads() : 1},
       {"hardware_threads", static_cast<int>(::sysconf(_SC_NPROCESSORS_ONLN))},
       {"seed", seed},
       {"host", host.data()},

@@ -22,7 +22,7 @@ struct GitState {
 GitState git_state(const std::filesystem::path& dir);
 
 /// Versions of the compiler and of every library that can change a result:
-/// {"compiler", "libtorch", "eigen", "cgal", "hdf5", "yaml_cpp", "fmt", "spdlog", "json"}, and the
+/// {"compiler", <the compute runtime, e.g. "libtorch">, "eigen", "cgal", "hdf5", "yaml_cpp", "fmt", "spdlog", "json"}, and the
 /// file the BLAS libtorch calls was loaded from ("blas").
 nlohmann::json library_versions();
 
@@ -39,13 +39,18 @@ void keep_freed_memory();
 /// pages a forked child held before exec. 0 where /proc is not available.
 double peak_memory_mib();
 
-/// Number of intra-op threads libtorch uses.
-int torch_threads();
+/// The tensor library the numerical layers run on (libtorch, registered at start-up by
+/// framework/tensors/threads.cpp): its name and version for library_versions(), and how to read
+/// its intra-op thread count for the env.json record. The core layer does not depend on it.
+struct ComputeRuntime {
+  std::string name;              ///< key in library_versions(), e.g. "libtorch"
+  std::string version;           ///< its version string
+  int (*threads)() = nullptr;    ///< its intra-op thread count
+};
 
-/// Sets libtorch's intra-op threads: `n`, or every hardware thread when `n` is 0. (OpenMP's own
-/// default is not reliable in containers: on our 2-core CI machine it picks 1.) Returns the
-/// count in effect.
-int set_torch_threads(int n);
+/// Registers the compute runtime (a static registrar of the layer that owns it). The last call
+/// wins; without one, library_versions() lists none and collect_environment() records 1 thread.
+void register_compute_runtime(ComputeRuntime runtime);
 
 /// The `env.json` record of a run: git commit and dirty flag of the source tree, compiler,
 /// library versions, build type, thread count, seed, host name, time (UTC, ISO 8601) and the

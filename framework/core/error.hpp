@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// Exception types of the library. Library code throws; only the CLI turns an exception into a
-/// message and an exit status (STYLE.md point 7).
+/// message and an exit status.
 
 #include <stdexcept>
 #include <string>

@@ -36,10 +36,15 @@ Registry<binders::Binder>& binder_registry() {
   return registry;
 }
 
+Registry<task::Task>& task_registry() {
+  static Registry<task::Task> registry("task");
+  return registry;
+}
+
 std::vector<const RegistryBase*> all_registries() {
   return {&distance_registry(), &graph_op_registry(), &model_registry(),
           &corrective_model_registry(), &loss_registry(), &metric_registry(),
-          &dataset_registry(), &binder_registry()};
+          &dataset_registry(), &binder_registry(), &task_registry()};
 }
 
 void verify_registries() {

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// One registry template and one accessor per plug-in category (STYLE.md points 1–3).
+/// One registry template and one accessor per plug-in category.
 ///
 /// A plug-in registers itself at the bottom of its own `.cpp`:
 ///
@@ -130,6 +130,7 @@ namespace losses { class Loss; }
 namespace eval { class Metric; }
 namespace datasets { class DatasetBuilder; }
 namespace binders { class Binder; }
+namespace task { class Task; }
 
 /// `distance`: vertex–bone distances (Euclidean, HollowDist, volumetric geodesic).
 Registry<distances::Distance>& distance_registry();
@@ -148,6 +149,7 @@ Registry<eval::Metric>& metric_registry();
 Registry<datasets::DatasetBuilder>& dataset_registry();
 /// `binder`: skinning weights from geometry alone, not learned (GeoVoxel, bone heat).
 Registry<binders::Binder>& binder_registry();
+Registry<task::Task>& task_registry();
 
 /// Every category, in the order above.
 std::vector<const RegistryBase*> all_registries();
@@ -163,7 +165,7 @@ void verify_registries();
 /// Registers `Class` under `key` in the `category` registry. `Class` has a nested `Options`
 /// struct with `static Options from(const config::Node&)` and a constructor taking `Options`.
 #define SKINLAB_REGISTER(category, key, Class)                                                 \
-  static const auto SKINLAB_CONCAT(skinlab_registrar_, __LINE__) = ::skinlab::Registrar(       \
+  static const auto SKINLAB_CONCAT(skinlab_registrar_, __COUNTER__) = ::skinlab::Registrar(       \
       ::skinlab::category##_registry(), #key,                                                  \
       [](const ::skinlab::config::Node& node) {                                                \
         return std::make_shared<Class>(Class::Options::from(node));                            \

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// Cleaning of builder output before preprocessing (issue 5, item 2), and the variant groups the
+/// Cleaning of builder output before preprocessing, and the variant groups the
 /// splits keep together (splits.hpp). Run by `skinlab prepare` between the builders and the
 /// preprocessing; every decision is recorded so the dataset card can report it per character.
 ///
@@ -45,7 +45,7 @@
 #include <string>
 #include <vector>
 
-#include "datasets/source.hpp"
+#include "framework/data/source.hpp"
 #include "framework/core/config.hpp"
 
 namespace skinlab::data {

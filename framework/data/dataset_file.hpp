@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "datasets/source.hpp"
+#include "framework/data/source.hpp"
 #include "framework/data/h5.hpp"
 #include "framework/geometry/skin_weights.hpp"
 

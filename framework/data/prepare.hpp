@@ -31,7 +31,7 @@
 #include <string>
 #include <vector>
 
-#include "datasets/source.hpp"
+#include "framework/data/source.hpp"
 #include "framework/core/config.hpp"
 #include "framework/data/clean.hpp"
 #include "framework/data/preprocess.hpp"

@@ -29,7 +29,7 @@
 #include <string>
 #include <vector>
 
-#include "datasets/source.hpp"
+#include "framework/data/source.hpp"
 #include "framework/core/config.hpp"
 #include "framework/data/dataset_file.hpp"
 #include "framework/distances/distance.hpp"

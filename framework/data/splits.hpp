@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// Train / validation / test splits of a dataset (issue 5, item 5), written to `/splits/<name>`
+/// Train / validation / test splits of a dataset, written to `/splits/<name>`
 /// of the dataset file (datasets/FORMAT.md) by `skinlab prepare`.
 ///
 /// - `random`: variant groups (clean.hpp) are shuffled with the seed and assigned one by one to

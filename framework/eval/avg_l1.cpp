@@ -1,6 +1,7 @@
 #include "framework/eval/avg_l1.hpp"
 
 #include "framework/core/registry.hpp"
+#include "framework/eval/value_display.hpp"
 #include "framework/eval/weights.hpp"
 
 namespace skinlab::eval {
@@ -26,4 +27,5 @@ std::map<std::string, double> AvgL1::operator()(const MetricInputs& in) const {
 
 }  // namespace skinlab::eval
 
+SKINLAB_DECLARE_VALUE({"avg_l1", "L1-norm", "", false, false, 4});
 SKINLAB_REGISTER(metric, avg_l1, skinlab::eval::AvgL1);

@@ -4,6 +4,7 @@
 #include <random>
 
 #include "framework/core/registry.hpp"
+#include "framework/eval/value_display.hpp"
 #include "framework/eval/weights.hpp"
 #include "framework/geometry/lbs.hpp"
 
@@ -94,4 +95,6 @@ std::map<std::string, double> DeformationError::operator()(const MetricInputs& i
 
 }  // namespace skinlab::eval
 
+SKINLAB_DECLARE_VALUE({"deformation_error", "Dist. err.", "", false, false, 6});
+SKINLAB_DECLARE_VALUE({"deformation_error_max", "Max dist. err.", "", false, false, 4});
 SKINLAB_REGISTER(metric, deformation_error, skinlab::eval::DeformationError);

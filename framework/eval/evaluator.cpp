@@ -13,7 +13,7 @@
 #include "framework/core/error.hpp"
 #include "framework/core/progress.hpp"
 #include "framework/core/registry.hpp"
-#include "framework/data/tensors.hpp"
+#include "framework/tensors/tensors.hpp"
 #include "framework/eval/evaluate.hpp"
 #include "framework/eval/metric.hpp"
 #include "framework/eval/predictions.hpp"
@@ -23,6 +23,7 @@
 #include "framework/train/distributed.hpp"
 #include "framework/train/run_data.hpp"
 #include "framework/train/trainer.hpp"
+#include "framework/eval/value_display.hpp"
 
 namespace skinlab::eval {
 
@@ -313,3 +314,6 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
 }
 
 }  // namespace skinlab::eval
+
+// The training objective on the evaluated part, when the run has `losses:`.
+SKINLAB_DECLARE_VALUE({"loss", "Loss", "", false, false, 4});

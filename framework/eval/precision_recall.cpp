@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "framework/core/registry.hpp"
+#include "framework/eval/value_display.hpp"
 #include "framework/eval/weights.hpp"
 
 namespace skinlab::eval {
@@ -49,4 +50,6 @@ std::map<std::string, double> PrecisionRecall::operator()(const MetricInputs& in
 
 }  // namespace skinlab::eval
 
+SKINLAB_DECLARE_VALUE({"precision", "Precision", "", true, true, 2});
+SKINLAB_DECLARE_VALUE({"recall", "Recall", "", true, true, 2});
 SKINLAB_REGISTER(metric, precision_recall, skinlab::eval::PrecisionRecall);

@@ -1,7 +1,7 @@
 #pragma once
 /// \file
-/// Predicted skin weights written back for the characters they were predicted for (issue 6,
-/// item 6): mapped from the prepared (merged, subdivided) vertices to the ORIGINAL vertices of
+/// Predicted skin weights written back for the characters they were predicted for:
+/// mapped from the prepared (merged, subdivided) vertices to the ORIGINAL vertices of
 /// the source mesh through PreparedCharacter::vertex_map, as per-joint weights in RigNet's rig
 /// text format (geometry/rig_io.hpp) and as bone and joint weights in one HDF5 file.
 ///

@@ -2,10 +2,10 @@
 /// \file
 /// Delta Mush (Mancewicz, Derksen, Rijpkema, Wilson, "Delta Mush: smoothing deformations while
 /// preserving detail", DigiPro 2014): the corrective deformer productions put after linear blend
-/// skinning. It is the non-linear target of our DenseGATs task (issue 9; DenseGATs, Li et al.
+/// skinning. It is the non-linear target of our DenseGATs task (DenseGATs, Li et al.
 /// I3D 2020, Sec. 3, learns h(G) = target − t(S) over LBS): the paper's artist-refined meshes
 /// are private, and Delta Mush over the artist's own LBS is what a rigger would apply to them.
-/// It is a deformer, not artist data, and the README and dataset card say so.
+/// It is a deformer, not artist data, and experiments/densegats/README.md and the dataset card say so.
 ///
 /// The method (Mancewicz et al. Sec. 2–3):
 /// 1. Smooth the rest mesh V with `iterations` steps of Laplacian smoothing,

@@ -67,7 +67,7 @@
 #include <vector>
 
 #include "framework/core/config.hpp"
-#include "framework/data/tensors.hpp"
+#include "framework/tensors/tensors.hpp"
 
 namespace skinlab::graph {
 
@@ -105,7 +105,7 @@ EdgeSet parse_edge_set(const config::Node& node);
 inline bool is_bone_set(EdgeSet set) { return set == EdgeSet::kSkeleton; }
 
 /// The index tensors of one character's heterogeneous graph (int64, CPU). Edge lists are #E×2
-/// rows (i, j): node i receives a message from its neighbour j (framework/data/tensors.hpp); the
+/// rows (i, j): node i receives a message from its neighbour j (framework/tensors/tensors.hpp); the
 /// mesh sets hold both directions of every edge, the geodesic set need not be symmetric.
 struct Graph {
   torch::Tensor one_ring;    ///< #E×2 vertex–vertex mesh edges

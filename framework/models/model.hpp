@@ -10,7 +10,7 @@
 
 #include <torch/torch.h>
 
-#include "framework/data/tensors.hpp"
+#include "framework/tensors/tensors.hpp"
 
 namespace skinlab::models {
 

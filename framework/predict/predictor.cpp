@@ -6,14 +6,14 @@
 #include <algorithm>
 #include <cmath>
 
-#include "datasets/source.hpp"
+#include "framework/data/source.hpp"
 #include "framework/core/atomic_file.hpp"
 #include "framework/core/config.hpp"
 #include "framework/core/error.hpp"
 #include "framework/core/timing.hpp"
 #include "framework/core/registry.hpp"
 #include "framework/data/h5.hpp"
-#include "framework/data/tensors.hpp"
+#include "framework/tensors/tensors.hpp"
 #include "framework/eval/evaluate.hpp"
 #include "framework/eval/predictions.hpp"
 #include "framework/eval/weights.hpp"

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// The dataset card (issue 5, item 6): a Markdown document generated from a dataset file
+/// The dataset card: a Markdown document generated from a dataset file
 /// (datasets/FORMAT.md), never typed: counts per source and split, skeleton families, vertex
 /// and bone histograms (PNG), every character with its group and split membership, every
 /// excluded character with its reason, and the licences and attribution the sources require.

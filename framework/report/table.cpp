@@ -9,6 +9,7 @@
 #include "framework/core/config.hpp"
 #include "framework/core/error.hpp"
 #include "framework/eval/anova.hpp"
+#include "framework/eval/value_display.hpp"
 
 namespace skinlab::report {
 
@@ -16,34 +17,12 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// How a metric is shown: its header, whether higher is better, and a value's text.
-struct Column {
-  std::string header;
-  bool higher_better = false;
-  bool percent = false;
-  int decimals = 4;
-};
-
-Column column_of(const std::string& metric) {
-  if (metric == "precision") return {"Precision ↑", true, true, 2};
-  if (metric == "recall") return {"Recall ↑", true, true, 2};
-  if (metric == "avg_l1") return {"L1-norm ↓", false, false, 4};
-  if (metric == "deformation_error") return {"Dist. err. ↓", false, false, 6};
-  if (metric == "deformation_error_max") return {"Max dist. err. ↓", false, false, 4};
-  if (metric == "loss") return {"Loss ↓", false, false, 4};
-  // The corrective-deformation task (DenseGATs Table 3), in cm.
-  if (metric == "mean_error_cm") return {"Mean err. (cm) ↓", false, false, 4};
-  if (metric == "max_error_cm") return {"Max err. (cm) ↓", false, false, 4};
-  if (metric == "min_error_cm") return {"Min err. (cm) ↓", false, false, 4};
-  return {metric, false, false, 4};
-}
-
-struct Stats {
+struct MeanSd {
   double mean = 0, sd = 0;
 };
 
-Stats stats_of(const std::vector<double>& x) {
-  Stats s;
+MeanSd stats_of(const std::vector<double>& x) {
+  MeanSd s;
   for (double v : x) s.mean += v;
   s.mean /= static_cast<double>(x.size());
   if (x.size() > 1) {
@@ -53,7 +32,7 @@ Stats stats_of(const std::vector<double>& x) {
   return s;
 }
 
-std::string value_text(double v, const Column& c) {
+std::string value_text(double v, const eval::ValueDisplay& c) {
   return c.percent ? fmt::format("{:.{}f}%", 100 * v, c.decimals) : fmt::format("{:.{}f}", v, c.decimals);
 }
 
@@ -195,12 +174,12 @@ std::string make_table(const std::vector<RunResult>& runs, const TableOptions& o
   }
 
   std::vector<std::vector<std::string>> main{{"Method", "Run"}};
-  for (const auto& m : options.metrics) main.front().push_back(column_of(m).header);
+  for (const auto& m : options.metrics) main.front().push_back(eval::value_display(m).column_header());
   for (const auto& run : runs) {
     std::vector<std::string> row{run.label, run.run_id};
     for (const auto& m : options.metrics) {
-      const Column c = column_of(m);
-      const Stats s = stats_of(run.values.at(m));
+      const eval::ValueDisplay c = eval::value_display(m);
+      const MeanSd s = stats_of(run.values.at(m));
       row.push_back(value_text(s.mean, c) + " ± " + value_text(s.sd, c));
     }
     main.push_back(std::move(row));
@@ -220,7 +199,7 @@ std::string make_table(const std::vector<RunResult>& runs, const TableOptions& o
       return same > 1 ? run.label + " (" + run.run_id + ")" : run.label;
     };
     std::vector<std::vector<std::string>> anova{{"One-way ANOVA vs " + name(ref)}};
-    for (const auto& m : options.metrics) anova.front().push_back(column_of(m).header + " F (p)");
+    for (const auto& m : options.metrics) anova.front().push_back(eval::value_display(m).column_header() + " F (p)");
     for (std::size_t r = 1; r < runs.size(); ++r) {
       std::vector<std::string> row{name(runs[r])};
       for (const auto& m : options.metrics) {

@@ -1,3 +1,4 @@
+#include "framework/tensors/threads.hpp"
 #include "framework/train/fit_support.hpp"
 
 #include <fmt/format.h>

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "framework/data/dataset_file.hpp"
-#include "framework/data/tensors.hpp"
+#include "framework/tensors/tensors.hpp"
 #include "framework/train/run_options.hpp"
 
 namespace skinlab::train {

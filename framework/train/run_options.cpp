@@ -1,11 +1,12 @@
 #include "framework/train/run_options.hpp"
 
 #include <cmath>
+#include <map>
 
 #include "framework/binders/binder.hpp"
 #include "framework/core/registry.hpp"
 #include "framework/losses/loss.hpp"
-#include "framework/models/corrective_model.hpp"
+#include "framework/task/task.hpp"
 
 namespace skinlab::train {
 
@@ -55,12 +56,17 @@ RunOptions RunOptions::from(const config::Config& config) {
   f.optional("threads", o.threads).check(o.threads >= 0, "threads", "must be ≥ 0 (0 = every hardware thread)");
   f.optional("results_dir", o.results_dir)
       .check(!o.results_dir.empty(), "results_dir", "must not be empty");
+  std::string known_tasks;
+  for (const auto& k : task_registry().keys()) known_tasks += (known_tasks.empty() ? "" : ", ") + k;
   f.optional("task", o.task)
-      .check(o.task == "skinning" || o.task == "corrective" || o.task == "sequence", "task",
-             "must be skinning (weights, the default), corrective (DenseGATs) or sequence "
-             "(the mesh-sequence BiLSTM)");
-  o.corrective = f.section("corrective");
-  o.sequences = f.section("sequences");
+      .check(task_registry().contains(o.task), "task",
+             "must be a registered task (" + known_tasks + "; skinning is the default)");
+  const task::Task& task = task::get(o.task);
+  // Every task's own section is read here, so that one in another task's config is named.
+  std::map<std::string, config::Node> task_sections;
+  for (const task::Task* t : task::all()) {
+    if (!t->section().empty()) task_sections[t->section()] = f.section(t->section());
+  }
   o.model = f.section("model");
   o.binder = f.section("binder");
   o.losses = f.section("losses");
@@ -69,20 +75,16 @@ RunOptions RunOptions::from(const config::Config& config) {
   const config::Node train = f.section("train");
   f.finish();
 
-  if (o.corrective.exists() && o.task != "corrective") {
-    o.corrective.fail("a 'corrective' section belongs to a config with task: corrective");
-  }
-  if (o.sequences.exists() && o.task != "sequence") {
-    o.sequences.fail("a 'sequences' section belongs to a config with task: sequence");
-  }
-  // A sequence model is validated by its task (experiments/bdlstm/sequence_task.hpp).
-  if (o.model.exists() && o.task != "sequence") {
-    if (o.task == "corrective") {
-      corrective_model_registry().create(o.model);
-    } else {
-      model_registry().create(o.model);
+  for (const task::Task* t : task::all()) {
+    if (t->section().empty()) continue;
+    const config::Node& node = task_sections.at(t->section());
+    if (t == &task) {
+      o.task_section = node;
+    } else if (node.exists()) {
+      node.fail("a '" + t->section() + "' section belongs to a config with task: " + t->name());
     }
   }
+  if (o.model.exists()) task.check_model(o.model);
   if (o.binder.exists()) {
     if (o.model.exists()) {
       o.binder.fail("a config has a 'model' (a network to train) or a 'binder' (weights from "
@@ -100,9 +102,7 @@ RunOptions RunOptions::from(const config::Config& config) {
   return o;
 }
 
-namespace {
-
-constexpr const char* kDataExample =
+const char* const kDataExample =
     "data: {file: <dataset .h5>, split: random, distance: hollow_dist}";
 
 void require_sections(const config::Config& config, const char* what,
@@ -116,22 +116,12 @@ void require_sections(const config::Config& config, const char* what,
   }
 }
 
-}  // namespace
-
 void RunOptions::require_training_sections(const config::Config& config) const {
   if (binder.exists()) {
     throw ConfigError(config.source() + ": a 'binder' is not trained; evaluate it with "
                       "`skinlab eval " + config.source() + " --split test`");
   }
-  if (task == "sequence") {  // its objective is sequences.objective (Eq. 3), not `losses:`
-    // Its data is a `data:` file or a `sequences.folder`; SequenceTrainer checks which.
-    require_sections(config, "training", {{&model, "model: {type: bdlstm}"}});
-    return;
-  }
-  require_sections(config, "training",
-                   {{&model, "model: {type: ...}"},
-                    {&losses, "losses: [{type: kl, weight: 1.0}, ...]"},
-                    {&data_node, kDataExample}});
+  task::get(task).require_training_sections(config, *this);
 }
 
 void RunOptions::require_binder_sections(const config::Config& config) const {

@@ -36,7 +36,9 @@
 /// and `data`. A config has a `model` or a `binder`, not both.
 
 #include <cstdint>
+#include <initializer_list>
 #include <string>
+#include <utility>
 
 #include "framework/core/config.hpp"
 
@@ -81,9 +83,10 @@ struct RunOptions {
   std::int64_t seed = 0;
   int threads = 0;
   std::string results_dir = "results";
-  std::string task = "skinning";  ///< skinning, corrective or sequence
-  config::Node corrective;  ///< the corrective task's section (missing when absent)
-  config::Node sequences;   ///< the sequence task's section (missing when absent)
+  std::string task = "skinning";  ///< a key of the task registry (framework/task/task.hpp)
+  /// The section only the task reads, named by the task (`corrective:`, `sequences:`); missing
+  /// when absent or when the task has none
+  config::Node task_section;
   config::Node model;    ///< missing when the config has no model section
   config::Node binder;   ///< missing when the config has no binder section
   config::Node losses;   ///< missing when the config has no losses section
@@ -96,11 +99,18 @@ struct RunOptions {
   /// RegistryError with the file, line and key path of the first problem.
   static RunOptions from(const config::Config& config);
 
-  /// Throws ConfigError naming the config file unless the sections training and evaluation need
-  /// (`model`, `losses`, `data`) are present.
+  /// Throws ConfigError naming the config file unless the sections training needs are present
+  /// (the task says which: by default `model`, `losses` and `data`).
   void require_training_sections(const config::Config& config) const;
   /// Throws ConfigError naming the config file unless `binder` and `data` are present.
   void require_binder_sections(const config::Config& config) const;
 };
+
+/// Throws ConfigError naming the config file when one of `sections` (a node and an example of
+/// it, e.g. "model: {type: ...}") is missing or null; `what` says what needs them.
+void require_sections(const config::Config& config, const char* what,
+                      std::initializer_list<std::pair<const config::Node*, const char*>> sections);
+/// An example `data:` section, for such messages.
+extern const char* const kDataExample;
 
 }  // namespace skinlab::train

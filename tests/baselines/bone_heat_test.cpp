@@ -13,6 +13,7 @@
 
 namespace skinlab {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using baselines::BoneHeat;
 using baselines::BoneHeatStats;
@@ -167,5 +168,6 @@ TEST(BoneHeat, MinetestPlayerBeatsUniformThreeNearest) {
   EXPECT_LT(l1, 1.10);
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab

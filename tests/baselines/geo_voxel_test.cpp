@@ -13,6 +13,7 @@
 
 namespace skinlab {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using baselines::GeoVoxel;
 using baselines::GeoVoxelStats;
@@ -229,5 +230,6 @@ TEST(GeoVoxel, MinetestPlayerBeatsUniformThreeNearest) {
   EXPECT_LT(l1, 1.45);
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab

@@ -12,7 +12,7 @@
 
 #include "framework/core/config.hpp"
 #include "framework/core/registry.hpp"
-#include "framework/data/tensors.hpp"
+#include "framework/tensors/tensors.hpp"
 #include "tests/train/train_fixtures.hpp"
 
 namespace skinlab::testing {

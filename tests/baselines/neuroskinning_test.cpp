@@ -12,6 +12,7 @@
 #include <map>
 #include <string>
 
+#include "framework/tensors/threads.hpp"
 #include "framework/core/environment.hpp"
 #include "framework/core/error.hpp"
 #include "framework/core/registry.hpp"
@@ -23,6 +24,7 @@
 
 namespace skinlab {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 namespace fs = std::filesystem;
 using baselines::NeuroSkinning;
@@ -154,5 +156,6 @@ TEST(NeuroSkinning, ShippedConfigValidates) {
   EXPECT_EQ(config.root()["data"]["distance"].as<std::string>(), "euclidean");
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab

@@ -13,6 +13,7 @@
 #include <sstream>
 #include <string>
 
+#include "framework/tensors/threads.hpp"
 #include "framework/core/environment.hpp"
 #include "framework/core/error.hpp"
 #include "framework/core/registry.hpp"
@@ -25,6 +26,7 @@
 
 namespace skinlab {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 namespace fs = std::filesystem;
 using baselines::RigNetSkin;
@@ -242,5 +244,6 @@ TEST(RigNetSkin, ShippedConfigValidates) {
   EXPECT_EQ(config.root()["model"]["type"].as<std::string>(), "rignet_skin");
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab

@@ -22,6 +22,7 @@
 
 namespace skinlab::bdlstm {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using skinlab::testing::expect_error;
 
@@ -274,5 +275,6 @@ TEST(FolderSequences, FramesThatAreNotTheTemplatesMeshAreNamed) {
       {"s.yaml", "up"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::bdlstm

@@ -14,6 +14,7 @@
 
 namespace skinlab::bdlstm {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using skinlab::testing::expect_error;
 
@@ -262,5 +263,6 @@ TEST(MeshVae, ExtrapolatesLinearlyInItsLatentSpace) {
       {"v.yaml", "hidden"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::bdlstm

@@ -14,6 +14,7 @@
 
 namespace skinlab::bdlstm {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 class SequenceTaskTest : public ::testing::Test {
  protected:
@@ -105,5 +106,6 @@ TEST_F(SequenceTaskTest, MeshVaeTrainsAndIsScoredOnTwoInitialFrames) {
   EXPECT_EQ(report.mean.count("e5_1if_mm"), 0u);
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::bdlstm

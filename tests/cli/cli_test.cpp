@@ -18,6 +18,7 @@
 
 namespace skinlab {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using testing::Result;
 using testing::run;
@@ -374,7 +375,7 @@ TEST(Cli, SmokeRunPrepareTrainEvalOnTheBundledSubset) {
 }
 
 
-// What CI runs of DenseGATs' task (issue 9): the bundled bipeds prepared, the smoke sweep of
+// What CI runs of DenseGATs' task: the bundled bipeds prepared, the smoke sweep of
 // configs/sweeps/densegats_smoke_table3.yaml (a tiny DenseGATs trained, the LBS and DQS rows
 // evaluated) through the binary, and its table.
 TEST(Cli, DenseGatsSmokeSweepOnTheBundledBipeds) {
@@ -482,7 +483,7 @@ TEST(Cli, DenseGatsSmokeSweepOnTheBundledBipeds) {
   EXPECT_EQ(read_file(net / "metrics.jsonl"), before);
 }
 
-// What CI runs of the mesh-sequence task (issue 10): the bundled sequences prepared, the smoke
+// What CI runs of the mesh-sequence task: the bundled sequences prepared, the smoke
 // sweep of configs/sweeps/bdlstm_smoke_tables.yaml (a tiny share-weight BiLSTM and its
 // unidirectional variant trained, ACAP extrapolation and the held frame evaluated) through the
 // binary, its Tables 1-2, and the errors of evaluating what cannot be evaluated.
@@ -596,5 +597,6 @@ TEST(Cli, BdlstmSmokeSweepOnTheBundledWolf) {
   for (const char* name : {"seq2", "seq3", "seq4"}) EXPECT_FALSE(std::filesystem::exists(dir / name));
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab

@@ -1,4 +1,4 @@
-// Data-parallel training and sharded preparation through the real binary (issue 11): two
+// Data-parallel training and sharded preparation through the real binary: two
 // processes on localhost (c10d, Gloo) train the tiny HeterSkinNet on the bundled 0 A.D. subset
 // to the same parameters as one process with the same effective batch; a worker that dies ends
 // the run with a clear error at once, and the run resumes from its last checkpoint in another
@@ -26,6 +26,7 @@
 
 namespace skinlab {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using testing::Result;
 using testing::run;
@@ -198,5 +199,6 @@ TEST_F(Distributed, OnlyTheSkinningTaskTrainsDataParallel) {
   EXPECT_NE(b.err.find("train.batch"), std::string::npos) << b.err;
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab

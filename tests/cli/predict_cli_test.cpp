@@ -18,6 +18,7 @@
 
 namespace skinlab {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 namespace fs = std::filesystem;
 using testing::Result;
@@ -219,5 +220,6 @@ TEST(PredictCli, GameCharacterExportedFromItsSourceIsSkinnedAndRendered) {
   EXPECT_FALSE(fs::exists(dir / "u.glb"));
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab

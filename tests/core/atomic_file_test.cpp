@@ -12,6 +12,7 @@
 
 namespace skinlab {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using testing::TempDir;
 
@@ -80,5 +81,6 @@ TEST(AtomicFile, MissingDirectoryNamesThePath) {
                                  {"absent.txt", "cannot open"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab

@@ -6,6 +6,7 @@
 
 namespace skinlab::config {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using skinlab::testing::expect_error;
 using skinlab::testing::TempDir;
@@ -200,5 +201,6 @@ TEST(Config, EmittedYamlReloadsToTheSameValues) {
   EXPECT_EQ(root.keys(), (std::vector<std::string>{"model", "seed"}));
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::config

@@ -6,6 +6,7 @@
 
 namespace skinlab {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 TEST(Progress, FormatsCountRateAndEta) {
   EXPECT_EQ(Progress::format("train", 25, 100, 10.0), "train 25/100 (25.0%) 2.50/s ETA 0:00:30");
@@ -44,5 +45,6 @@ TEST(Progress, LongIntervalOnlyReportsTheEnd) {
   EXPECT_EQ(lines[0].rfind("items 1000/1000", 0), 0u);
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab

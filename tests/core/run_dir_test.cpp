@@ -2,8 +2,6 @@
 
 #include <gtest/gtest.h>
 
-#include <thread>
-
 #include "framework/core/atomic_file.hpp"
 #include "framework/core/config.hpp"
 #include "framework/core/environment.hpp"
@@ -12,6 +10,7 @@
 
 namespace skinlab {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using testing::expect_error;
 using testing::TempDir;
@@ -35,7 +34,7 @@ TEST(RunDir, WritesTheFourFiles) {
     EXPECT_TRUE(env.contains(key)) << key;
   }
   EXPECT_EQ(env["seed"], 3);
-  for (const char* lib : {"compiler", "libtorch", "eigen", "cgal", "hdf5"}) {
+  for (const char* lib : {"compiler", "eigen", "cgal", "hdf5"}) {
     EXPECT_FALSE(env["libraries"][lib].get<std::string>().empty()) << lib;
   }
   EXPECT_GE(env["threads"].get<int>(), 1);
@@ -44,14 +43,6 @@ TEST(RunDir, WritesTheFourFiles) {
   const auto records = run.read_metrics();
   ASSERT_EQ(records.size(), 2u);
   EXPECT_EQ(records[1]["loss"], 0.25);
-}
-
-TEST(Environment, SetsTorchThreads) {
-  EXPECT_EQ(set_torch_threads(1), 1);
-  EXPECT_EQ(torch_threads(), 1);
-  EXPECT_GE(set_torch_threads(0), 1);
-  EXPECT_EQ(torch_threads(), static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
-  expect_error<Error>([] { set_torch_threads(-1); }, {"thread count"});
 }
 
 TEST(RunDir, NeverOverwritesAnExistingRun) {
@@ -91,5 +82,6 @@ TEST(RunDir, MalformedMetricsLineIsNamed) {
   expect_error<Error>([&] { run.append_metrics(nlohmann::json::array()); }, {"JSON object"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab

@@ -13,6 +13,7 @@
 
 namespace skinlab::data {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 /// A box-like grid surface (n×n quads in the x–y plane, bent in z) with a 5-joint chain up y;
 /// vertex v is weighted between the two joints nearest its height, unless `rigid`.
@@ -227,5 +228,6 @@ TEST(Splits, OptionsAreValidated) {
   EXPECT_THROW(CleaningOptions::from(config::Config::parse("min_bone: 3").root()), ConfigError);
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::data

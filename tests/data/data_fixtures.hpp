@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "datasets/source.hpp"
+#include "framework/data/source.hpp"
 #include "framework/core/config.hpp"
 #include "framework/core/registry.hpp"
 #include "framework/data/dataset_file.hpp"

@@ -15,6 +15,7 @@
 
 namespace skinlab {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using testing::expect_error;
 using testing::TempDir;
@@ -212,5 +213,6 @@ TEST(DatasetFile, ReadableByH5py) {
             "1 ['alpha', 'beta'] (4, 3) [1, 3, 2] (4, 400) gzip True [1] CC0-1.0 (2, 3, 12)\n");
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab

@@ -7,6 +7,7 @@
 
 namespace skinlab::data {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using skinlab::testing::expect_error;
 using skinlab::testing::TempDir;
@@ -64,5 +65,6 @@ TEST(H5, BadFilesAreNamed) {
   expect_error<IoError>([&] { H5Reader r(text); }, {"text.h5: not an HDF5 file"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::data

@@ -12,6 +12,7 @@
 
 namespace skinlab {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using testing::TempDir;
 
@@ -109,5 +110,6 @@ TEST(Prepare, ConfigErrorsComeBeforeAnyWork) {
   EXPECT_FALSE(std::filesystem::exists(dir / "out"));
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab

@@ -18,6 +18,7 @@
 
 namespace skinlab {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using testing::TempDir;
 
@@ -230,5 +231,6 @@ TEST(FolderBuilder, ReadsCharactersAndExcludesBadFiles) {
       [&] { dataset_registry().create(config::Config::parse("type: folder").root()); }, {"path"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab

@@ -15,6 +15,7 @@
 
 namespace skinlab::datasets {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 const std::string kBundled = SKINLAB_SOURCE_DIR "/datasets/cube2/bundled";
 const std::string kModel = kBundled + "/snoutx10k/snoutx10k.iqm";
@@ -173,5 +174,6 @@ TEST(Cube2, RegisteredWithOptions) {
   testing::expect_error<ConfigError>([&] { dataset_registry().create(typo.root()); }, {"pth"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::datasets

@@ -17,6 +17,7 @@
 
 namespace skinlab::datasets {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 const std::string kBundled = SKINLAB_SOURCE_DIR "/datasets/nexuiz/bundled";
 const std::string kModel = kBundled + "/models/player/marine.zym";
@@ -252,5 +253,6 @@ TEST(Nexuiz, RegisteredWithOptions) {
   testing::expect_error<IoError>([&] { builder->read(excluded); }, {"/nonexistent/data.pk3"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::datasets

@@ -23,6 +23,7 @@
 
 namespace skinlab::datasets {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using namespace zeroad;
 
@@ -382,5 +383,6 @@ TEST(ZeroAdBuilder, OptionsFromConfig) {
   EXPECT_THROW(dataset_registry().create(missing.root())->read(excluded), IoError);
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::datasets

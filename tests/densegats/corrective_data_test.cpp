@@ -16,6 +16,7 @@
 
 namespace skinlab::densegats {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using skinlab::testing::expect_error;
 using CorrectiveDataTest = BundledBipeds;
@@ -168,5 +169,6 @@ TEST(CorrectiveOptions, AreValidated) {
   EXPECT_THROW(parse("{skeletons: Biped}"), ConfigError);
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::densegats

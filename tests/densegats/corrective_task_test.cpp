@@ -17,6 +17,7 @@
 
 namespace skinlab::densegats {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using skinlab::testing::expect_error;
 using CorrectiveTaskTest = BundledBipeds;
@@ -166,5 +167,6 @@ TEST_F(CorrectiveTaskTest, BadConfigsFailBeforeAnythingIsWritten) {
   EXPECT_TRUE(fs::is_empty(dir.path()));
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::densegats

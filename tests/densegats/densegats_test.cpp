@@ -12,6 +12,7 @@
 
 namespace skinlab::experiments {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 /// The one-ring graph of a small closed tube (8 sides × 5 rings + 2 cap centres = 42 vertices).
 graph::Graph tube_graph() {
@@ -186,5 +187,6 @@ TEST(NeuroSkinningCorrective, ThePaperWidthsGiveADisplacementThatStartsAtZero) {
                ConfigError);
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::experiments

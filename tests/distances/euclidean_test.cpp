@@ -12,6 +12,7 @@
 
 namespace skinlab::distances {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using skinlab::testing::expect_error;
 using geometry::point_segment_distance;
@@ -82,5 +83,6 @@ TEST(EuclideanDistance, InvalidMeshIsAGeometryError) {
       {"euclidean distance", "face 0", "vertex 5"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::distances

@@ -26,6 +26,7 @@
 
 namespace skinlab::distances {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using geometry::Mesh;
 using geometry::point_segment_distance;
@@ -584,5 +585,6 @@ TEST(HollowDistOptions, ErrorsNameTheField) {
                             {"resolution", "expected"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::distances

@@ -25,6 +25,7 @@
 
 namespace skinlab::distances {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using geometry::Mesh;
 using geometry::Skeleton;
@@ -463,5 +464,6 @@ TEST(VolumetricGeodesic, InvalidMeshIsAGeometryError) {
                                         {"distance 'volumetric_geodesic'", "face 3"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::distances

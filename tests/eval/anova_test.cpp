@@ -12,6 +12,7 @@
 
 namespace skinlab {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 TEST(Anova, TwoGroupsByHand) {
   // means 2 and 5, grand mean 3.5: SS_between = 2·3·1.5² = 13.5, SS_within = 2 + 2 = 4.
@@ -54,5 +55,6 @@ TEST(Anova, BadInputsAreErrors) {
                       {"group 0 has a non-finite value"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab

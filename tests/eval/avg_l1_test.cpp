@@ -8,6 +8,7 @@
 
 namespace skinlab::eval {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using testing::make_metric;
 using testing::weights;
@@ -50,5 +51,6 @@ TEST(AvgL1, MatchesATorchReferenceOnRandomWeights) {
   EXPECT_NEAR((*make_metric("{type: avg_l1}"))({pred, target}).at("avg_l1"), expected, 1e-12);
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::eval

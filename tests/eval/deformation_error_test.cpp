@@ -11,6 +11,7 @@
 
 namespace skinlab::eval {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using testing::make_metric;
 using testing::weights;
@@ -180,5 +181,6 @@ TEST(DeformationError, ArgumentErrors) {
       {"metric 'deformation_error' (character 'arm')", "[3, 3]", "#V×#B = [3, 2]"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::eval

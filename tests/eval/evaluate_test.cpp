@@ -11,6 +11,7 @@
 
 namespace skinlab::eval {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using skinlab::testing::expect_error;
 
@@ -91,5 +92,6 @@ TEST(MeanOverCharacters, DifferentNamesAreAnError) {
       {"character 1 reports {c}"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::eval

@@ -10,6 +10,7 @@
 
 namespace skinlab::eval {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using skinlab::testing::expect_error;
 using skinlab::testing::make_metric;
@@ -87,5 +88,6 @@ TEST(MetricOptions, DeformationErrorErrors) {
                              "known fields: fraction, poses, prune, seed, sigma_degrees, type"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::eval

@@ -9,6 +9,7 @@
 
 namespace skinlab::eval {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using testing::make_metric;
 using testing::weights;
@@ -89,5 +90,6 @@ TEST(PrecisionRecall, MatchesATorchReferenceOnRandomWeights) {
               1e-12);
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::eval

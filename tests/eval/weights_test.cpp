@@ -13,6 +13,7 @@
 
 namespace skinlab::eval {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using skinlab::testing::expect_error;
 using skinlab::testing::weights;
@@ -132,5 +133,6 @@ TEST(ReadWeights, RejectsNegativeAndNonFiniteWeights) {
   EXPECT_EQ(pair.pred, rows({{1, 0}, {0, 1}}));
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::eval

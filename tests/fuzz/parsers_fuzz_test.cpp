@@ -186,7 +186,7 @@ std::vector<std::pair<std::size_t, std::size_t>> numeric_storage(const fs::path&
 // indices, edges, top-K, splits, ...), the part of the file whose meaning only our reader
 // checks. HDF5's own structures (superblock, object headers, B-trees, the global heap of the
 // strings) are left intact: mutating them exercises libhdf5, not us, and this fuzzer found that
-// libhdf5 1.10.8 can loop forever in H5HG_read on a damaged global heap (see the README).
+// libhdf5 1.10.8 can loop forever in H5HG_read on a damaged global heap (docs/development.md).
 TEST(Fuzz, DatasetReaderRejectsOrAcceptsEveryMutatedValue) {
   TempDir dir;
   data::Dataset dataset;

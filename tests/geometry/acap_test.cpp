@@ -17,6 +17,7 @@
 
 namespace skinlab::geometry {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using skinlab::testing::expect_error;
 
@@ -216,5 +217,6 @@ TEST(Acap, BadInputNamesTheVertex) {
                               {"lonely.obj", "vertex " + std::to_string(m.V.rows()), "no edge"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::geometry

@@ -19,6 +19,7 @@
 
 namespace skinlab::geometry {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using skinlab::testing::expect_error;
 
@@ -174,5 +175,6 @@ TEST(DeltaMush, BadInputIsAnErrorNamingTheSourceAndVertex) {
   expect_error<GeometryError>([&] { mush.deform(posed); }, {"tube.obj", "vertex 17", "non-finite"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::geometry

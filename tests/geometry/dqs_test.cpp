@@ -14,6 +14,7 @@
 
 namespace skinlab::geometry {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using skinlab::testing::expect_error;
 
@@ -113,5 +114,6 @@ TEST(Dqs, OneInfluenceIsTheJointsRigidMotionAndBadInputIsAnError) {
   expect_error<GeometryError>([&] { dqs(V, W, {T[0]}); }, {"2×2", "#V×#J = 2×1"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::geometry

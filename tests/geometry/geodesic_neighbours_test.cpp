@@ -13,6 +13,7 @@
 #include "tests/test_util.hpp"
 
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 namespace st = skinlab::testing;
 using namespace skinlab::geometry;
@@ -190,4 +191,5 @@ TEST(GeodesicNeighbours, RejectsBadInput) {
                                        {"geodesic_neighbours", "no vertices"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace

@@ -16,6 +16,7 @@
 
 namespace skinlab {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using testing::TempDir;
 
@@ -103,5 +104,6 @@ TEST(GltfMorphAnimation, BadInputIsNamedAndWritesNothing) {
   EXPECT_FALSE(std::filesystem::exists(dir / "a.glb"));
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab

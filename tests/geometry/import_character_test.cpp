@@ -13,6 +13,7 @@
 
 namespace skinlab::geometry {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using skinlab::testing::GltfMesh;
 using skinlab::testing::GltfScene;
@@ -394,5 +395,6 @@ TEST(ImportCharacter, MissingOrUnreadableFileIsAnIoError) {
                                           {"junk.gltf", "assimp cannot read it"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::geometry

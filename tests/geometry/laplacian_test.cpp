@@ -11,6 +11,7 @@
 #include "tests/test_util.hpp"
 
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 namespace st = skinlab::testing;
 using namespace skinlab::geometry;
@@ -157,4 +158,5 @@ TEST(Laplacian, RejectsBadInput) {
       {"laplacian", "degenerate_ratio"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace

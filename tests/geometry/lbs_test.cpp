@@ -8,6 +8,7 @@
 
 namespace skinlab::geometry {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 /// Joints root (0,0,0) → child (0,1,0). Vertices: (0,0.5,0) on root, (0,2,0) on child, (1,1,0)
 /// half and half.
@@ -145,5 +146,6 @@ TEST(Lbs, RandomPoseRejectsBadArguments) {
                                                 {"sigma_degrees"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::geometry

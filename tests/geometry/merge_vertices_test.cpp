@@ -8,6 +8,7 @@
 #include "tests/test_util.hpp"
 
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 namespace st = skinlab::testing;
 using namespace skinlab::geometry;
@@ -177,4 +178,5 @@ TEST(MergeVertices, RejectsBadInput) {
       {"average_vertex_data", "3 rows", "2 original vertices"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace

@@ -10,6 +10,7 @@
 
 namespace skinlab::geometry {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 /// A box character standing along +Z (Z up): x ∈ [1, 3], y ∈ [−1, 0], z ∈ [2, 6]; joints at the
 /// bottom and top of its axis.
@@ -103,5 +104,6 @@ TEST(Normalize, MinetestPlayerIsScaledFrom17Units) {
   EXPECT_NO_THROW(c.validate());
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::geometry

@@ -9,6 +9,7 @@
 #include "tests/test_util.hpp"
 
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 namespace st = skinlab::testing;
 using namespace skinlab::geometry;
@@ -92,4 +93,5 @@ TEST(OneRing, RejectsBadInput) {
   st::expect_error<GeometryError>([&] { one_ring(m); }, {"one_ring", "vertex 1", "non-finite"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace

@@ -8,6 +8,7 @@
 
 namespace skinlab::geometry {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 /// A closed unit-ish tetrahedron at `offset`, wound outwards (or inwards when `inwards`).
 void add_tetrahedron(Eigen::MatrixXd& V, Eigen::MatrixXi& F, const Eigen::Vector3d& offset,
@@ -63,5 +64,6 @@ TEST(OrientOutward, FlipsOnlyThePartsWoundInwards) {
   EXPECT_EQ(again.flipped_parts, 0);
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::geometry

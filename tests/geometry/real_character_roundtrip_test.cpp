@@ -15,6 +15,7 @@
 
 namespace skinlab::geometry {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 const std::filesystem::path kPlayer =
     "/usr/share/games/minetest/games/minetest_game/mods/player_api/models/character.b3d";
@@ -59,5 +60,6 @@ TEST(RealCharacter, LoadCharacterErrors) {
       {"character.b3d: a rig file", "goes with an OBJ mesh"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::geometry

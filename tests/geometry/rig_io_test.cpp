@@ -9,6 +9,7 @@
 
 namespace skinlab::geometry {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using skinlab::testing::expect_error;
 using skinlab::testing::TempDir;
@@ -142,5 +143,6 @@ TEST(RigIo, WriterRejectsUnwritableNames) {
   EXPECT_FALSE(std::filesystem::exists(dir / "x.txt"));
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::geometry

@@ -9,6 +9,7 @@
 #include "tests/test_util.hpp"
 
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 namespace st = skinlab::testing;
 using namespace skinlab::geometry;
@@ -139,4 +140,5 @@ TEST(Subdivide, RejectsBadInput) {
                                        {"subdivide", "face 2 refers to vertex 7"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace

@@ -9,6 +9,7 @@
 
 namespace skinlab::geometry {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using skinlab::testing::expect_error;
 
@@ -177,5 +178,6 @@ TEST(CharacterValidate, ChecksAllParts) {
   expect_error<GeometryError>([&] { c.validate(); }, {"hero: "});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::geometry

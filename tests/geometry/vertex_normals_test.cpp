@@ -10,6 +10,7 @@
 
 namespace skinlab::geometry {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 TEST(VertexNormals, FlatGridPointsAlongPlusZ) {
   const Mesh m = testing::grid(3, 2, 0.5, 0.1);  // counter-clockwise seen from +z
@@ -45,5 +46,6 @@ TEST(VertexNormals, VertexOnNoFaceIsZero) {
   for (int v = 0; v < 4; ++v) EXPECT_NEAR(n.row(v).norm(), 1.0, 1e-12);
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::geometry

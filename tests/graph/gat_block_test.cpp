@@ -16,6 +16,7 @@
 
 namespace skinlab::graph {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using skinlab::testing::expect_error;
 using namespace skinlab::graph::testing;
@@ -461,5 +462,6 @@ TEST(GatBlock, BuildAndForwardErrorsNameTheOp) {
                            {"gat_block: the graph has no geodesic edges"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::graph

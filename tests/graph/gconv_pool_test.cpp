@@ -14,6 +14,7 @@
 
 namespace skinlab::graph {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using skinlab::testing::expect_error;
 using namespace skinlab::graph::testing;
@@ -110,5 +111,6 @@ TEST(GconvPool, ErrorsNameTheOptionOrTheEdge) {
   expect_error<c10::Error>([&] { no_vertex->build({0, 6, 3}); }, {"gconv_pool", "width is 0"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::graph

@@ -13,6 +13,7 @@
 
 namespace skinlab::graph {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using skinlab::testing::expect_error;
 using namespace skinlab::graph::testing;
@@ -379,5 +380,6 @@ INSTANTIATE_TEST_SUITE_P(GraphOps, EveryOp,
                                            "mean_conv", "mesh_conv", "v2b"),
                          [](const auto& info) { return info.param; });
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::graph

@@ -11,6 +11,7 @@
 
 namespace skinlab::graph {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using skinlab::testing::expect_error;
 using namespace skinlab::graph::testing;
@@ -247,5 +248,6 @@ TEST(GlobalPool, DefaultsAndGradientsOfTheLiteralOrder) {
       {"global_pool: pools bone features, but their input width is 0"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::graph

@@ -11,6 +11,7 @@
 
 namespace skinlab::graph {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using skinlab::testing::expect_error;
 using namespace skinlab::graph::testing;
@@ -241,5 +242,6 @@ TEST(MeshConv, DefaultsAreThePaperWidths) {
   EXPECT_EQ(o.edges, (std::vector<EdgeSet>{EdgeSet::kOneRing, EdgeSet::kGeodesic}));
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::graph

@@ -12,6 +12,7 @@
 
 namespace skinlab::graph {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using skinlab::testing::expect_error;
 using namespace skinlab::graph::testing;
@@ -142,11 +143,13 @@ TEST(MeanConv, WidthsAndErrors) {
   expect_error<c10::Error>([&] { no_vertex->build({0, 6, 3}); }, {"mean_conv", "width is 0"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::graph
 
 namespace skinlab::graph {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using namespace skinlab::graph::testing;
 
@@ -172,5 +175,6 @@ TEST(MeanConv, SparseOperatorMatchesTheOp) {
   EXPECT_THROW(mean_operator(edge_tensor({{0, 9}}), 8, false), c10::Error);
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::graph

@@ -15,6 +15,7 @@
 
 namespace skinlab::losses {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using skinlab::testing::expect_error;
 
@@ -155,5 +156,6 @@ TEST(LossSum, ConfigErrors) {
                             {"losses[0].eps: must be in (0, 1)"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::losses

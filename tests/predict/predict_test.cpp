@@ -26,6 +26,7 @@
 
 namespace skinlab {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 namespace fs = std::filesystem;
 using testing::expect_error;
@@ -366,5 +367,6 @@ TEST(GltfExport, MoreThanFourInfluencesUseASecondSetOrAreCutToFour) {
   EXPECT_FALSE(fs::exists(dir / "x.glb"));
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab

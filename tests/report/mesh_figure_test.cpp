@@ -13,6 +13,7 @@
 
 namespace skinlab::report {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 Rgb pixel(const Image& im, int x, int y) {
   const std::size_t i = 3 * (static_cast<std::size_t>(y) * im.width + x);
@@ -145,5 +146,6 @@ TEST(Ply, HeaderRowsAndValues) {
   EXPECT_FALSE(std::filesystem::exists(dir / "n.ply"));
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::report

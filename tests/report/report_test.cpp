@@ -13,6 +13,7 @@
 
 namespace skinlab::report {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 std::uint32_t u32(const std::string& s, std::size_t at) {
   std::uint32_t v = 0;
@@ -139,5 +140,6 @@ TEST(DatasetCard, ReportsCountsSplitsExclusionsAndLicences) {
   }
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::report

@@ -13,6 +13,7 @@
 
 namespace skinlab {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 namespace fs = std::filesystem;
 using testing::TempDir;
@@ -114,5 +115,6 @@ TEST(Table, RunsOnOtherCharactersMissingMetricsAndMissingEvaluationsAreErrors) {
   testing::expect_error<Error>([&] { report::make_table({ours}, bad); }, {"unknown format 'html'"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab

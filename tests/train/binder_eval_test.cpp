@@ -61,6 +61,7 @@ SKINLAB_REGISTER(binder, test_nearest_bone, skinlab::testing::NearestBoneBinder)
 
 namespace skinlab {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 namespace fs = std::filesystem;
 using testing::TempDir;
@@ -138,5 +139,6 @@ TEST(BinderEval, ModelAndBinderInOneConfigIsAConfigError) {
       {"b.yaml: a 'binder' is not trained", "skinlab eval b.yaml"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab

@@ -13,6 +13,7 @@
 
 namespace skinlab::train {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 /// Sets environment variables for the test's duration.
 class Environment {
@@ -74,5 +75,6 @@ TEST(World, OfOneProcessChangesNothing) {
   world.barrier();
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::train

@@ -7,6 +7,7 @@
 
 #include <fstream>
 
+#include "framework/tensors/threads.hpp"
 #include "framework/core/atomic_file.hpp"
 #include "framework/core/environment.hpp"
 #include "framework/core/registry.hpp"
@@ -46,6 +47,7 @@ SKINLAB_REGISTER(metric, test_l1, skinlab::testing::TestL1Metric);
 
 namespace skinlab {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 namespace fs = std::filesystem;
 using testing::expect_error;
@@ -205,5 +207,6 @@ TEST(Predictions, ToSourceVerticesAndJointWeights) {
   EXPECT_DOUBLE_EQ(J(1, 1), 1.0);
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab

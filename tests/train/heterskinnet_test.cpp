@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "../test_util.hpp"
+#include "framework/tensors/threads.hpp"
 #include "framework/core/environment.hpp"
 #include "framework/core/error.hpp"
 #include "framework/core/registry.hpp"
@@ -14,6 +15,7 @@
 
 namespace skinlab {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 namespace fs = std::filesystem;
 
@@ -119,5 +121,6 @@ TEST(HeterSkinNet, ShippedExperimentConfigsValidate) {
   }
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab

@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <thread>
 
+#include "framework/tensors/threads.hpp"
 #include "framework/core/atomic_file.hpp"
 #include "framework/core/environment.hpp"
 #include "framework/core/registry.hpp"
@@ -29,6 +30,7 @@ extern char** environ;
 
 namespace skinlab {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 namespace fs = std::filesystem;
 using testing::expect_error;
@@ -403,5 +405,6 @@ TEST_F(Training, KilledRunResumesToTheUninterruptedResultAndCheckpointsAreNeverP
   EXPECT_EQ(records(straight), records(run));
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab

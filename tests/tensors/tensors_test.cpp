@@ -5,13 +5,14 @@
 #include <gtest/gtest.h>
 
 #include "framework/data/preprocess.hpp"
-#include "framework/data/tensors.hpp"
+#include "framework/tensors/tensors.hpp"
 #include "tests/data/data_fixtures.hpp"
 #include "tests/test_util.hpp"
 #include "tests/train/train_fixtures.hpp"
 
 namespace skinlab {
 namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
 using testing::expect_error;
 
@@ -123,5 +124,6 @@ TEST(ScatterToBones, RejectsBadArguments) {
                            {"2 candidates per vertex but only 1 bones"});
 }
 
+}  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab

@@ -1,4 +1,4 @@
-#include "framework/data/tensors.hpp"
+#include "framework/tensors/tensors.hpp"
 
 #include "framework/core/error.hpp"
 #include "framework/data/preprocess.hpp"
