@@ -25,24 +25,16 @@
 #include <string>
 #include <vector>
 
+#include "framework/report/figure_options.hpp"
+
 namespace skinlab::densegats {
-
-struct CorrectiveFigureOptions {
-  std::string part = "test";
-  std::vector<std::string> characters;  ///< empty: the first `count` of the first run's part
-  int count = 2;
-  int poses = 3;                        ///< per character, evenly spaced over the saved poses
-  double error_max_cm = 0;              ///< top of the colour scale; 0: per figure, from its 99th percentile
-  std::filesystem::path out;
-  std::string command;                  ///< the command line, for the README
-};
-
 
 /// Writes `<out>/<character>_pose<index>.png` per character and pose, one vertex-coloured PLY
 /// per run, character and pose under `<out>/<experiment>/`, and `<out>/README.md` (captions,
 /// per-run mean errors of each figure, the command). Throws IoError / ConfigError as the file
-/// comment says; nothing is written before every run is opened and checked.
-void write_corrective_figures(const std::vector<std::string>& run_dirs,
-                              const CorrectiveFigureOptions& options);
+/// comment says; nothing is written before every run is opened and checked. Reads runs, part,
+/// characters, count, poses, error_max_cm and out of `options`; `command` is quoted in the
+/// README.
+void write_corrective_figures(const report::FigureOptions& options, const std::string& command);
 
 }  // namespace skinlab::densegats

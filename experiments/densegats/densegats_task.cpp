@@ -53,23 +53,16 @@ class CorrectiveTask final : public task::Task {
     return evaluate_corrective(run, options);
   }
   void figures(const task::FigureOptions& options) const override {
-    CorrectiveFigureOptions o;
-    o.part = options.part;
-    o.characters = options.characters;
-    o.count = options.count;
-    o.poses = options.poses;
-    o.error_max_cm = options.error_max_cm;
-    o.out = options.out;
-    o.command = fmt::format("skinlab figure {} --part {} --poses {} --out {}",
-                            fmt::join(options.runs, " "), options.part, options.poses,
-                            options.out.string());
+    std::string command = fmt::format("skinlab figure {} --part {} --poses {} --out {}",
+                                      fmt::join(options.runs, " "), options.part, options.poses,
+                                      options.out.string());
     if (!options.characters.empty()) {
-      o.command += fmt::format(" --characters {}", fmt::join(options.characters, ","));
+      command += fmt::format(" --characters {}", fmt::join(options.characters, ","));
     } else {
-      o.command += fmt::format(" --count {}", options.count);
+      command += fmt::format(" --count {}", options.count);
     }
-    if (options.error_max_cm > 0) o.command += fmt::format(" --error-max {}", options.error_max_cm);
-    write_corrective_figures(options.runs, o);
+    if (options.error_max_cm > 0) command += fmt::format(" --error-max {}", options.error_max_cm);
+    write_corrective_figures(options, command);
   }
 };
 

@@ -16,47 +16,33 @@ Command add_figure(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "figure", "per-vertex L1 and deformation error maps of evaluated runs (PNG and PLY)");
   struct Args {
-    std::vector<std::string> runs;
-    std::string part = "test";
-    std::vector<std::string> characters;
-    int count = 3;
-    double l1_max = 1.0;
-    int poses = 3;
-    double error_max_cm = 0;
+    task::FigureOptions options;
     std::string out;
   };
   auto args = std::make_shared<Args>();
-  cmd->add_option("runs", args->runs, "evaluated run directories, one column each")->required();
-  cmd->add_option("--part", args->part, "evaluated part (predictions/<part>.h5)")
+  cmd->add_option("runs", args->options.runs, "evaluated run directories, one column each")->required();
+  cmd->add_option("--part", args->options.part, "evaluated part (predictions/<part>.h5)")
       ->capture_default_str();
-  cmd->add_option("--characters", args->characters, "characters to draw (default: --count)")
+  cmd->add_option("--characters", args->options.characters, "characters to draw (default: --count)")
       ->delimiter(',');
-  cmd->add_option("--count", args->count, "the first N characters of the part")
+  cmd->add_option("--count", args->options.count, "the first N characters of the part")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  cmd->add_option("--l1-max", args->l1_max, "top of the L1 colour scale (L1 is in [0, 2])")
+  cmd->add_option("--l1-max", args->options.l1_max, "top of the L1 colour scale (L1 is in [0, 2])")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  cmd->add_option("--poses", args->poses,
+  cmd->add_option("--poses", args->options.poses,
                   "corrective runs: evaluation poses per character, evenly spaced")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  cmd->add_option("--error-max", args->error_max_cm,
+  cmd->add_option("--error-max", args->options.error_max_cm,
                   "corrective runs: top of the error colour scale in cm (default: each "
                   "figure's 99th percentile)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--out", args->out, "output directory")->required();
   return {cmd, [args] {
-            task::FigureOptions o;
-            o.runs = args->runs;
-            o.part = args->part;
-            o.characters = args->characters;
-            o.count = args->count;
-            o.l1_max = args->l1_max;
-            o.poses = args->poses;
-            o.error_max_cm = args->error_max_cm;
-            o.out = args->out;
-            task::of_run(RunDir::open(args->runs.front())).figures(o);
+            args->options.out = args->out;
+            task::of_run(RunDir::open(args->options.runs.front())).figures(args->options);
             return 0;
           }};
 }

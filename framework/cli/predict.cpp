@@ -13,10 +13,6 @@
 /// input are ignored by the prediction; with `--compare-to-input` the model's metrics
 /// (HeterSkinNet Sec. 4.3) against them are printed. Every output is checked before any work
 /// starts and written whole (atomic rename), so a failure never leaves a partial file.
-///
-/// HDF5 layout: /weights (#V×#B float32, bones in RigNet's order), /joint_weights (#V×#J),
-/// /bones (#B×2 start, end joints), /joint_names, /vertices (#V×3, input frame); attributes
-/// model, distance, prune, character.
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -30,12 +26,8 @@
 #include "framework/core/environment.hpp"
 #include "framework/core/error.hpp"
 #include "framework/core/timing.hpp"
-#include "framework/data/h5.hpp"
-#include "framework/eval/predictions.hpp"
-#include "framework/geometry/gltf_export.hpp"
 #include "framework/geometry/load_character.hpp"
-#include "framework/geometry/rig_io.hpp"
-#include "framework/geometry/vertex_normals.hpp"
+#include "framework/predict/outputs.hpp"
 #include "framework/predict/predictor.hpp"
 #include "framework/report/plot.hpp"
 #include "framework/report/skin_render.hpp"
@@ -69,40 +61,10 @@ struct PredictArgs {
   bool error_map = false;
 };
 
-enum class OutputKind { gltf, rig, h5 };
-
-OutputKind output_kind(const fs::path& out) {
-  const std::string name = out.filename().string();
-  const std::string ext = out.extension().string();
-  if (ext == ".glb" || ext == ".gltf") return OutputKind::gltf;
-  if (ext == ".h5" || ext == ".hdf5") return OutputKind::h5;
-  if (ext == ".txt") return OutputKind::rig;
-  throw Error(out.string() + ": unknown output type '" + ext +
-              "' (use .glb, .gltf, _rig.txt or .h5)");
-}
-
-/// The default model: the bundled one of the source tree.
-fs::path default_model() { return source_dir() / "results" / "bundled" / "heterskinnet"; }
-
 Eigen::Vector3d up_axis(const std::string& up) {
   if (up == "y") return Eigen::Vector3d::UnitY();
   if (up == "z") return Eigen::Vector3d::UnitZ();
   throw Error("--up must be y or z, got '" + up + "'");
-}
-
-void write_h5(const fs::path& out, const geometry::Character& input,
-              const predict::Prediction& p, const predict::Predictor& predictor, double prune) {
-  data::H5Writer w(out);
-  w.write("weights", p.source_weights);
-  w.write("joint_weights", data::RowMatrixXd(Eigen::MatrixXd(p.joint_weights)));
-  w.write("bones", p.prepared.bones);
-  w.write_strings("joint_names", input.skeleton.names);
-  w.write("vertices", data::RowMatrixXd(input.mesh.V));
-  w.write_attribute("model", predictor.description());
-  w.write_attribute("distance", predictor.distance());
-  w.write_attribute("prune", fmt::format("{}", prune));
-  w.write_attribute("character", input.name);
-  w.commit();
 }
 
 int run(const PredictArgs& args) {
@@ -110,7 +72,7 @@ int run(const PredictArgs& args) {
   if (args.out.empty() && args.render.empty()) {
     throw Error("predict: give at least one --out file or --render");
   }
-  for (const auto& out : args.out) output_kind(out);  // before any work
+  for (const auto& out : args.out) predict::output_kind(out);  // before any work
   if (!args.render.empty() && fs::path(args.render).extension() != ".png") {
     throw Error(args.render + ": --render writes a .png file");
   }
@@ -138,7 +100,7 @@ int run(const PredictArgs& args) {
                 ", but the input carries no skin weights");
   }
 
-  const fs::path model_dir = args.model.empty() ? default_model() : fs::path(args.model);
+  const fs::path model_dir = args.model.empty() ? predict::default_model() : fs::path(args.model);
   start = Clock::now();
   const predict::Predictor predictor = predict::Predictor::load(model_dir, args.checkpoint);
   const double model_seconds = seconds_since(start);
@@ -150,29 +112,8 @@ int run(const PredictArgs& args) {
   }
 
   start = Clock::now();
-  geometry::Character result;
-  result.name = input.name;
-  result.mesh = input.mesh;
-  result.skeleton = input.skeleton;
-  result.weights = p.joint_weights;
   for (const auto& out : args.out) {
-    switch (output_kind(out)) {
-      case OutputKind::gltf: {
-        geometry::GltfExportOptions gltf;
-        gltf.normals = geometry::vertex_normals(input.mesh);
-        geometry::write_gltf(out, result, gltf);
-        break;
-      }
-      case OutputKind::rig: {
-        geometry::Skeleton named = eval::source_skeleton(p.prepared);
-        named.positions = input.skeleton.positions;
-        geometry::write_rig(out, named, p.joint_weights);
-        break;
-      }
-      case OutputKind::h5:
-        write_h5(out, input, p, predictor, args.prune);
-        break;
-    }
+    predict::write_prediction(out, input, p, predictor, args.prune);
     std::cout << "wrote " << out << "\n";
   }
   times.export_ = seconds_since(start);
@@ -239,59 +180,15 @@ int run_score(const std::string& input, const std::string& rig, const std::strin
               const std::string& model, bool allow_unweighted) {
   const geometry::Character truth = geometry::load_character(input, rig);
   if (!truth.has_weights()) throw Error(input + ": carries no skin weights to score against");
-  const fs::path file = weights;
-  geometry::Skeleton other_skeleton;
-  geometry::SparseWeights other;
-  if (file.extension() == ".txt") {
-    geometry::WeightCheck check;
-    check.allow_unweighted = allow_unweighted;
-    geometry::Rig r = geometry::read_rig(file, truth.mesh.num_vertices(), check);
-    other_skeleton = r.skeleton;
-    other = r.weights;
-  } else {
-    geometry::Character c = geometry::load_character(file);
-    if (c.mesh.num_vertices() != truth.mesh.num_vertices()) {
-      throw Error(fmt::format("{}: {} vertices, but {} has {}", weights, c.mesh.num_vertices(),
-                              input, truth.mesh.num_vertices()));
-    }
-    other_skeleton = c.skeleton;
-    other = c.weights;
-  }
-  if (other.rows() != truth.mesh.num_vertices()) {
-    throw Error(weights + ": no weights for the " + std::to_string(truth.mesh.num_vertices()) +
-                " vertices of " + input);
-  }
-  // Columns by joint name onto the truth's skeleton.
-  std::vector<Eigen::Triplet<double>> entries;
-  for (Eigen::Index v = 0; v < other.outerSize(); ++v) {
-    for (geometry::SparseWeights::InnerIterator it(other, v); it; ++it) {
-      const std::string& name = other_skeleton.names[static_cast<std::size_t>(it.col())];
-      const int j = truth.skeleton.find(name);
-      if (j < 0) throw Error(weights + ": joint '" + name + "' is not a joint of " + input);
-      entries.emplace_back(static_cast<int>(v), j, it.value());
-    }
-  }
-  geometry::SparseWeights mapped(truth.mesh.num_vertices(), truth.skeleton.num_joints());
-  mapped.setFromTriplets(entries.begin(), entries.end());
-  int unweighted = 0;
-  for (Eigen::Index v = 0; v < mapped.rows(); ++v) {
-    if (!(mapped.row(v).sum() > 0)) {
-      if (!allow_unweighted) {
-        throw Error(fmt::format("{}: vertex {} has no weight (--allow-unweighted scores it as "
-                                "predicting no bone)",
-                                weights, v));
-      }
-      ++unweighted;
-      continue;
-    }
-    mapped.row(v) /= mapped.row(v).sum();
-  }
+  const predict::OtherWeights other = predict::read_other_weights(weights, truth, input, allow_unweighted);
+  const geometry::SparseWeights& mapped = other.weights;
+  const int unweighted = other.unweighted;
   if (unweighted > 0) {
     std::cout << fmt::format("{}: {} of {} vertices have no weight; scored as predicting no bone "
                              "(their linear blend skinning puts them at the origin)\n",
                              weights, unweighted, mapped.rows());
   }
-  const fs::path model_dir = model.empty() ? default_model() : fs::path(model);
+  const fs::path model_dir = model.empty() ? predict::default_model() : fs::path(model);
   const predict::Predictor predictor = predict::Predictor::load(model_dir);
   print_metrics(weights + " against the weights of " + input + ":", predictor.score(truth, mapped));
   return 0;

@@ -131,6 +131,12 @@ fs::path run_entry(const Sweep& sweep, const Entry& entry, int threads) {
                   " resolves to now; move it away or rename the sweep");
     }
   }
+  // An untrained method (binder, baseline) whose run has its evaluation is not evaluated again:
+  // the same config gives the same values, and its dataset need not be on this machine.
+  if (existed && binder && fs::exists(dir / ("eval_" + sweep.part + ".json"))) {
+    std::cout << fmt::format("== {} → {} (saved evaluation)\n", entry.config, dir.string());
+    return dir;
+  }
   // A committed run keeps its evaluation but not its checkpoints (git ignores *.pt): its saved
   // evaluation is its row. Without both it can neither resume nor be evaluated, and training
   // it again from scratch would overwrite its history, so that is an error.

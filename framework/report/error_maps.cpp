@@ -92,7 +92,7 @@ Image panel(const data::PreparedCharacter& c,
 
 }  // namespace
 
-void write_error_maps(const ErrorMapOptions& options) {
+void write_error_maps(const FigureOptions& options) {
   std::vector<FigureRun> runs;
   for (const auto& dir : options.runs) runs.push_back(open_run(dir, options.part));
   std::vector<std::string> names = options.characters;

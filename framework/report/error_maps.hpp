@@ -8,23 +8,12 @@
 /// config names, and the run's own `metrics:` options (pruning, poses), so the maps average to
 /// the run's eval numbers. What `skinlab figure` draws for skinning runs.
 
-#include <filesystem>
-#include <string>
-#include <vector>
+#include "framework/report/figure_options.hpp"
 
 namespace skinlab::report {
 
-struct ErrorMapOptions {
-  std::vector<std::string> runs;        ///< evaluated run directories, one column each
-  std::string part = "test";            ///< evaluated part
-  std::vector<std::string> characters;  ///< empty: the first `count` of the first run's part
-  int count = 3;
-  double l1_max = 1.0;                  ///< top of the L1 colour scale (L1 is in [0, 2])
-  std::filesystem::path out;            ///< output directory (created)
-};
-
-/// Writes the maps; prints a line per character to stdout. IoError for a run without saved
+/// Writes the maps of `options.runs` (reads part, characters, count, l1_max, out); prints a line per character to stdout. IoError for a run without saved
 /// predictions of the part or a character missing from a run or its dataset.
-void write_error_maps(const ErrorMapOptions& options);
+void write_error_maps(const FigureOptions& options);
 
 }  // namespace skinlab::report

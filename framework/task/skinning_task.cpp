@@ -36,16 +36,7 @@ class SkinningTask final : public Task {
   eval::EvalReport evaluate(const RunDir& run, const eval::EvalOptions& options) const override {
     return eval::evaluate(run, options);
   }
-  void figures(const FigureOptions& options) const override {
-    report::ErrorMapOptions o;
-    o.runs = options.runs;
-    o.part = options.part;
-    o.characters = options.characters;
-    o.count = options.count;
-    o.l1_max = options.l1_max;
-    o.out = options.out;
-    report::write_error_maps(o);
-  }
+  void figures(const FigureOptions& options) const override { report::write_error_maps(options); }
 };
 
 }  // namespace

@@ -55,30 +55,37 @@ std::map<std::string, std::shared_ptr<Task>>& instances() {
 
 }  // namespace
 
-int int_option(const std::map<std::string, std::string>& values, const std::string& name) {
+namespace {
+
+/// The option's value parsed whole by `parse` (std::stoi, std::stod); Error saying `what` it
+/// expected otherwise.
+template <class T, class Parse>
+T parse_option(const std::map<std::string, std::string>& values, const std::string& name,
+               const char* what, Parse parse) {
   const std::string& text = option_text(values, name);
   std::size_t used = 0;
-  int value = 0;
+  T value{};
   try {
-    value = std::stoi(text, &used);
+    value = parse(text, &used);
   } catch (const std::exception&) {
     used = 0;
   }
-  if (used == 0 || used != text.size()) throw Error("--" + name + ": expected an integer, got '" + text + "'");
+  if (used == 0 || used != text.size()) {
+    throw Error("--" + name + ": expected " + what + ", got '" + text + "'");
+  }
   return value;
 }
 
+}  // namespace
+
+int int_option(const std::map<std::string, std::string>& values, const std::string& name) {
+  return parse_option<int>(values, name, "an integer",
+                           [](const std::string& t, std::size_t* n) { return std::stoi(t, n); });
+}
+
 double double_option(const std::map<std::string, std::string>& values, const std::string& name) {
-  const std::string& text = option_text(values, name);
-  std::size_t used = 0;
-  double value = 0;
-  try {
-    value = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != text.size()) throw Error("--" + name + ": expected a number, got '" + text + "'");
-  return value;
+  return parse_option<double>(values, name, "a number",
+                              [](const std::string& t, std::size_t* n) { return std::stod(t, n); });
 }
 
 std::string string_option(const std::map<std::string, std::string>& values, const std::string& name,

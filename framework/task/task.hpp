@@ -18,6 +18,7 @@
 #include "framework/core/registry.hpp"
 #include "framework/core/run_dir.hpp"
 #include "framework/eval/evaluator.hpp"
+#include "framework/report/figure_options.hpp"
 #include "framework/report/table.hpp"
 #include "framework/train/run_options.hpp"
 #include "framework/train/trainer.hpp"
@@ -34,16 +35,7 @@ class TaskTrainer {
 };
 
 /// `skinlab figure`'s options; each task reads the ones it draws with.
-struct FigureOptions {
-  std::vector<std::string> runs;        ///< evaluated run directories, one column each
-  std::string part = "test";            ///< evaluated part (predictions/<part>.h5)
-  std::vector<std::string> characters;  ///< empty: the first `count` of the first run's part
-  int count = 2;
-  double l1_max = 1.0;        ///< skinning: top of the L1 colour scale
-  int poses = 3;              ///< corrective: evaluation poses per character
-  double error_max_cm = 0;    ///< corrective: top of the error scale (0: per figure)
-  std::filesystem::path out;  ///< output directory
-};
+using FigureOptions = report::FigureOptions;
 
 /// An option of a task's own command: `--<name> <value>`.
 struct CommandOption {

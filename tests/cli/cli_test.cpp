@@ -468,10 +468,14 @@ TEST(Cli, DenseGatsSmokeSweepOnTheBundledBipeds) {
   // evaluation instead of training it again; without that either, it refuses to retrain.
   for (const char* pt : {"best.pt", "last.pt"}) std::filesystem::remove(net / pt);
   const std::string before = read_file(net / "metrics.jsonl");
+  const std::string lbs_eval = read_file(lbs / "eval_test.json");
   const Result again = run("sweep " + (dir / "sweep.yaml").string());
   ASSERT_EQ(again.status, 0) << again.err;
   EXPECT_NE(again.out.find("saved evaluation; no checkpoint to resume"), std::string::npos)
       << again.out;
+  // The untrained rows are not evaluated again either: their saved evaluation is their row.
+  EXPECT_NE(again.out.find(lbs.string() + " (saved evaluation)"), std::string::npos) << again.out;
+  EXPECT_EQ(read_file(lbs / "eval_test.json"), lbs_eval);
   EXPECT_EQ(read_file(net / "metrics.jsonl"), before);
   std::filesystem::remove(net / "eval_test.json");
   const Result gone = run("sweep " + (dir / "sweep.yaml").string());

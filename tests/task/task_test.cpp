@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
 
 #include "framework/core/config.hpp"
 #include "framework/core/error.hpp"
@@ -131,6 +132,18 @@ TEST(Task, TrainsEvaluatesAndTabulatesThroughTheRegistry) {
       {"c.yaml", "skinning task's", "a counting run is evaluated in one process"});
   // A task without figures says so.
   expect_error<Error>([] { task::get("counting").figures({}); }, {"counting", "no figures"});
+}
+
+TEST(Task, CommandOptionsParseWholeValuesOrSayWhich) {
+  const std::map<std::string, std::string> values = {{"frames", "15"}, {"fps", "2.5"},
+                                                     {"bad", "3x"}, {"clip", "walk"}};
+  EXPECT_EQ(task::int_option(values, "frames"), 15);
+  EXPECT_DOUBLE_EQ(task::double_option(values, "fps"), 2.5);
+  EXPECT_EQ(task::string_option(values, "clip"), "walk");
+  EXPECT_EQ(task::string_option(values, "start", "none"), "none");
+  expect_error<Error>([&] { task::int_option(values, "bad"); }, {"--bad", "an integer", "'3x'"});
+  expect_error<Error>([&] { task::double_option(values, "clip"); }, {"--clip", "a number"});
+  expect_error<Error>([&] { task::int_option(values, "start"); }, {"--start", "needs a value"});
 }
 
 TEST(ValueDisplay, MetricsDeclareHowTheirValuesAreShown) {
