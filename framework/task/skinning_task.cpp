@@ -22,7 +22,7 @@ class SkinningTrainer final : public TaskTrainer {
   bool validated() const override { return !trainer_.data().part("val").empty(); }
 
  private:
-  mutable train::Trainer trainer_;
+  train::Trainer trainer_;
 };
 
 class SkinningTask final : public Task {

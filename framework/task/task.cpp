@@ -53,10 +53,6 @@ std::map<std::string, std::shared_ptr<Task>>& instances() {
   return tasks;
 }
 
-}  // namespace
-
-namespace {
-
 /// The option's value parsed whole by `parse` (std::stoi, std::stod); Error saying `what` it
 /// expected otherwise.
 template <class T, class Parse>
@@ -112,7 +108,10 @@ std::vector<const Task*> all() {
 
 const Task& of(const config::Config& config) {
   const config::Node key = config.root()["task"];
-  return get(key.exists() ? key.as<std::string>() : "skinning");
+  if (!key.exists()) return get("skinning");
+  const std::string name = key.as<std::string>();
+  if (!task_registry().contains(name)) key.fail(task_registry().unknown_key_message(name));
+  return get(name);
 }
 
 const Task& of_run(const RunDir& run) { return of(config::Config::load(run.file("config.yaml"))); }

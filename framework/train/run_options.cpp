@@ -56,11 +56,8 @@ RunOptions RunOptions::from(const config::Config& config) {
   f.optional("threads", o.threads).check(o.threads >= 0, "threads", "must be ≥ 0 (0 = every hardware thread)");
   f.optional("results_dir", o.results_dir)
       .check(!o.results_dir.empty(), "results_dir", "must not be empty");
-  std::string known_tasks;
-  for (const auto& k : task_registry().keys()) known_tasks += (known_tasks.empty() ? "" : ", ") + k;
   f.optional("task", o.task)
-      .check(task_registry().contains(o.task), "task",
-             "must be a registered task (" + known_tasks + "; skinning is the default)");
+      .check(task_registry().contains(o.task), "task", task_registry().unknown_key_message(o.task));
   const task::Task& task = task::get(o.task);
   // Every task's own section is read here, so that one in another task's config is named.
   std::map<std::string, config::Node> task_sections;

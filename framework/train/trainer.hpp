@@ -89,6 +89,7 @@ class Trainer {
   const RunOptions& options() const { return options_; }
   models::Model& model() { return *model_; }
   RunData& data() { return data_; }
+  const RunData& data() const { return data_; }
 
   /// Mean loss over `part` ("train", "val", "test") in eval mode without gradients; `parts`
   /// receives each term's mean.
