@@ -102,7 +102,7 @@ Eigen::MatrixXd BoneHeat::bind(const geometry::Mesh& input, const geometry::Skel
   std::vector<Eigen::Vector3d> root(nb), tip(nb);
   for (int b = 0; b < nb; ++b) {
     root[b] = skeleton.positions.row(bones[b].start).transpose();
-    tip[b] = skeleton.positions.row(bones[b].end).transpose();
+    tip[b] = skeleton.bone_end(bones[b]);
   }
 
   // ---- triangles: normals, AABB tree, the Laplacian, areas, components ----------------------

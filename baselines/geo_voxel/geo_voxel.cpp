@@ -229,7 +229,7 @@ Eigen::MatrixXd GeoVoxel::distances(const geometry::Mesh& input,
     sc.touched.clear();
     sc.heap.clear();
     const Eigen::Vector3d a = skeleton.positions.row(bones[b].start).transpose();
-    const Eigen::Vector3d e = skeleton.positions.row(bones[b].end).transpose();
+    const Eigen::Vector3d e = skeleton.bone_end(bones[b]);
     grid.overlapping_cells(a, e, e, sc.seeds);
     for (int c : sc.seeds) {
       if (!solid(c)) continue;
@@ -280,7 +280,7 @@ Eigen::MatrixXd GeoVoxel::distances(const geometry::Mesh& input,
     const Eigen::Vector3d p = mesh.V.row(v).transpose();
     for (int b = 0; b < nb; ++b) {
       D(v, b) = geometry::point_segment_distance(p, skeleton.positions.row(bones[b].start),
-                                                 skeleton.positions.row(bones[b].end));
+                                                 skeleton.bone_end(bones[b]));
     }
   }
   return D;

@@ -7,11 +7,13 @@
 /// (entries are vertex×bone pairs with artist weight above 1e-4, the influence threshold of
 /// HeterSkinNet Sec. 4.2 and of the `precision_recall` metric):
 /// - influences per vertex: how many bones influence a vertex (the histogram 1, 2, 3, 4, 5+);
-/// - entry coverage: the share of influential entries whose bone is one of the vertex's K
-///   candidates, i.e. the highest recall any method that predicts over the candidates can reach
-///   (before pruning); pooled over all entries of the characters;
-/// - weight coverage: the mean over vertices of the artist weight on the candidates (what the
-///   training targets keep before renormalisation).
+/// - entry and weight coverage for K = 1..6 (data/coverage.hpp, the paper's Fig. 6): the share
+///   of influential entries, and of the artist weight, on each vertex's K nearest bones; entry
+///   coverage at the prepared K is the highest recall any method that predicts over the
+///   candidates can reach (before pruning);
+/// - what the missed entries at the prepared K are: helper bones, distance ties, and candidate
+///   slots taken by bones of joints that carry no weight.
+/// `--coverage-figures DIR` draws the coverage curves per distance and writes them as CSV.
 
 #include <fmt/format.h>
 
@@ -22,7 +24,10 @@
 #include <numeric>
 
 #include "framework/cli/commands.hpp"
+#include "framework/core/atomic_file.hpp"
+#include "framework/data/coverage.hpp"
 #include "framework/data/dataset_file.hpp"
+#include "framework/report/plot.hpp"
 
 namespace skinlab::cli {
 
@@ -33,30 +38,36 @@ int merged(const data::PreparedCharacter& c) {
   return c.vertex_map.empty() ? 0 : *std::max_element(c.vertex_map.begin(), c.vertex_map.end()) + 1;
 }
 
-/// Influence threshold of the coverage figures (precision_recall's default, Sec. 4.2).
-constexpr double kInfluential = 1e-4;
+/// K = 1..kMaxK in the coverage table and figure (the paper's Fig. 6 runs to 6 or so).
+constexpr int kMaxK = 6;
 
-/// Prints the candidate coverage of `distance` over the characters `which` of `d`.
+/// Coverage of every stored distance over the characters `which` of `d` (those with weights).
+std::map<std::string, data::Coverage> coverage_of(const data::Dataset& d,
+                                                  const std::vector<int>& which) {
+  std::map<std::string, data::Coverage> out;
+  for (int i : which) {
+    const data::PreparedCharacter& c = d.characters[i];
+    if (c.weights.rows() == 0) continue;
+    for (const auto& [type, dd] : c.distances) {
+      const int k = std::max(1, std::min<int>(static_cast<int>(dd.topk_index.cols()), kMaxK));
+      out[type].add(data::candidate_coverage(c, type, kMaxK, k));
+    }
+  }
+  return out;
+}
+
+/// Prints the candidate coverage (data/coverage.hpp) of every distance over `which`.
 void print_coverage(const data::Dataset& d, const std::vector<int>& which,
                     const std::string& label) {
-  std::map<std::string, std::array<double, 3>> per_distance;  // covered, weight sum, vertices
-  std::array<long, 6> histogram{};                            // 0 .. 5+ influences
-  long entries = 0;
+  std::array<long, 6> histogram{};  // 0 .. 5+ influences per vertex
   for (int i : which) {
     const data::PreparedCharacter& c = d.characters[i];
     for (int v = 0; v < c.weights.rows(); ++v) {
       int n = 0;
       for (geometry::SparseWeights::InnerIterator it(c.weights, v); it; ++it) {
-        n += it.value() > kInfluential;
+        n += it.value() > data::kInfluential;
       }
       ++histogram[std::min(n, 5)];
-      entries += n;
-    }
-    for (const auto& [type, dd] : c.distances) {
-      auto& acc = per_distance[type];
-      acc[0] += static_cast<double>((dd.targets.array() > kInfluential).count());
-      acc[1] += dd.targets.sum();
-      acc[2] += static_cast<double>(dd.targets.rows());
     }
   }
   long vertices = 0;
@@ -67,19 +78,65 @@ void print_coverage(const data::Dataset& d, const std::vector<int>& which,
   std::cout << fmt::format(
       "  influences per vertex (weight > {}): 1: {:.1f}%, 2: {:.1f}%, 3: {:.1f}%, 4: {:.1f}%, "
       "5+: {:.1f}%, none: {:.1f}%\n",
-      kInfluential, 100.0 * histogram[1] / vertices, 100.0 * histogram[2] / vertices,
+      data::kInfluential, 100.0 * histogram[1] / vertices, 100.0 * histogram[2] / vertices,
       100.0 * histogram[3] / vertices, 100.0 * histogram[4] / vertices,
       100.0 * histogram[5] / vertices, 100.0 * histogram[0] / vertices);
-  for (const auto& [type, acc] : per_distance) {
+  for (const auto& [type, cov] : coverage_of(d, which)) {
+    std::string entry, weight;
+    for (int k = 1; k <= cov.max_k; ++k) {
+      entry += fmt::format(" {}: {:.2f}%", k, 100 * cov.entry_share(k));
+      weight += fmt::format(" {}: {:.2f}%", k, 100 * cov.weight_share(k));
+    }
+    std::cout << fmt::format("  {}: entry coverage at K ={} (at the prepared K = {}: the recall "
+                             "ceiling of K-candidate methods)\n",
+                             type, entry, cov.diagnose_k);
+    std::cout << fmt::format("  {}: weight coverage at K ={}\n", type, weight);
     std::cout << fmt::format(
-        "  {}: entry coverage {:.2f}% (the recall ceiling of K-candidate methods), weight "
-        "coverage {:.2f}%\n",
-        type, entries > 0 ? 100.0 * acc[0] / entries : 0.0,
-        acc[2] > 0 ? 100.0 * acc[1] / acc[2] : 0.0);
+        "  {}: missed at K = {}: {} influential entries, {:.1f}% of them on a leaf's helper "
+        "bone, {:.1f}% tied in distance with the K-th candidate; {:.1f}% of the candidate slots "
+        "hold a bone whose joint has no weight anywhere on its character\n",
+        type, cov.diagnose_k, cov.missed,
+        cov.missed > 0 ? 100.0 * cov.missed_helper / cov.missed : 0.0,
+        cov.missed > 0 ? 100.0 * cov.missed_tied / cov.missed : 0.0,
+        cov.slots > 0 ? 100.0 * cov.weightless_slots / cov.slots : 0.0);
   }
 }
 
-int run_dataset_info(const std::string& file) {
+/// Fig. 6 on the dataset: per distance, weight coverage (blue) and entry coverage (orange)
+/// against K over all characters, as `coverage_<distance>.png`, and every value in
+/// `coverage.csv` (distance, part, K, entry, weight), in `dir`.
+void write_coverage_figures(const data::Dataset& d, const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir);
+  std::vector<std::pair<std::string, std::vector<int>>> parts;
+  std::vector<int> all(d.characters.size());
+  std::iota(all.begin(), all.end(), 0);
+  parts.emplace_back("all", all);
+  for (const auto& [name, s] : d.splits) parts.emplace_back("test:" + name, s.test);
+  std::string csv = "distance,part,k,entry_coverage,weight_coverage\n";
+  for (const auto& [part, which] : parts) {
+    for (const auto& [type, cov] : coverage_of(d, which)) {
+      for (int k = 1; k <= cov.max_k; ++k) {
+        csv += fmt::format("{},{},{},{:.6f},{:.6f}\n", type, part, k, cov.entry_share(k),
+                           cov.weight_share(k));
+      }
+      if (part != "all") continue;
+      report::Series weight, entry;
+      weight.colour = {70, 110, 170};
+      entry.colour = {230, 130, 40};
+      for (int k = 1; k <= cov.max_k; ++k) {
+        weight.x.push_back(k);
+        weight.y.push_back(cov.weight_share(k));
+        entry.x.push_back(k);
+        entry.y.push_back(cov.entry_share(k));
+      }
+      report::write_png(dir / ("coverage_" + type + ".png"), report::line_plot({weight, entry}));
+    }
+  }
+  write_file_atomic(dir / "coverage.csv", csv);
+  std::cout << fmt::format("coverage figures and coverage.csv written to {}\n", dir.string());
+}
+
+int run_dataset_info(const std::string& file, const std::string& figures) {
   const data::Dataset d = data::read_dataset(file);
   std::cout << fmt::format("{}: format_version {}, skinlab {}\n", file, data::kFormatVersion,
                            d.git_commit);
@@ -108,6 +165,7 @@ int run_dataset_info(const std::string& file) {
   print_coverage(d, all, "all characters");
   for (const auto& [name, s] : d.splits)
     print_coverage(d, s.test, "test part of split '" + name + "'");
+  if (!figures.empty()) write_coverage_figures(d, figures);
   std::cout << fmt::format("excluded: {}\n", d.excluded.size());
   for (const auto& e : d.excluded) {
     std::cout << fmt::format("  {}:{}: {}\n", e.source, e.path, e.reason);
@@ -122,8 +180,12 @@ Command add_dataset_info(CLI::App& app) {
                                  "counts, characters, distances and splits of a "
                                  "dataset file");
   auto file = std::make_shared<std::string>();
+  auto figures = std::make_shared<std::string>();
   cmd->add_option("file", *file, "dataset file (.h5)")->required();
-  return {cmd, [file] { return run_dataset_info(*file); }};
+  cmd->add_option("--coverage-figures", *figures,
+                  "directory for the candidate-coverage figures (HeterSkinNet Fig. 6 per "
+                  "distance) and coverage.csv");
+  return {cmd, [file, figures] { return run_dataset_info(*file, *figures); }};
 }
 
 }  // namespace skinlab::cli

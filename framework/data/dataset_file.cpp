@@ -28,6 +28,7 @@ void write_character(H5Writer& w, const PreparedCharacter& c) {
   w.write(g + "/parents", c.parents);
   w.write(g + "/joints", c.joints);
   w.write(g + "/bones", c.bones);
+  if (c.leaf_tips.size() > 0) w.write(g + "/leaf_tips", c.leaf_tips);
   // CSR of the row-major #V×#J weights.
   geometry::SparseWeights W = c.weights;
   W.makeCompressed();
@@ -158,6 +159,11 @@ PreparedCharacter read_character(const H5Reader& r, const std::string& name) {
   check.shape(g + "/bones", c.bones, -1, 2);
   check.indices(g + "/bones", values_of(c.bones), 0, nj, "joint");
   const long nb = c.bones.rows();
+  if (r.has(g + "/leaf_tips")) {
+    c.leaf_tips = r.read_double(g + "/leaf_tips");
+    check.shape(g + "/leaf_tips", c.leaf_tips, nj, 3);
+    check.finite(g + "/leaf_tips", values_of(c.leaf_tips));
+  }
 
   const auto indptr = r.read_ints(g + "/weights/indptr");
   const auto indices = r.read_ints(g + "/weights/indices");
@@ -306,6 +312,26 @@ void write_dataset(const std::filesystem::path& file, const Dataset& dataset, in
   w.commit();
 }
 
+geometry::Skeleton PreparedCharacter::rig() const {
+  geometry::Skeleton s;
+  s.names = joint_names;
+  s.parents = parents;
+  s.positions = joints;
+  s.leaf_tips = leaf_tips;
+  s.validate(name);
+  const auto list = s.bones();
+  bool same = static_cast<Eigen::Index>(list.size()) == bones.rows();
+  for (std::size_t b = 0; same && b < list.size(); ++b) {
+    const auto i = static_cast<Eigen::Index>(b);
+    same = list[b].start == bones(i, 0) && list[b].end == bones(i, 1);
+  }
+  if (!same) {
+    throw IoError(name + ": the stored bones are not the skeleton's bones in RigNet's order "
+                  "(Skeleton::bones()); re-prepare the dataset with this build");
+  }
+  return s;
+}
+
 Eigen::Isometry3d joint_transform(const float* m) {
   Eigen::Matrix3d r;
   Eigen::Vector3d t;
@@ -325,10 +351,11 @@ Dataset read_dataset(const std::filesystem::path& file) {
     throw IoError(file.string() + ": not a skinlab dataset (no root attribute 'format_version')");
   }
   const std::int64_t version = r.read_int_attribute("/", "format_version");
-  if (version != kFormatVersion) {
+  if (version < kOldestReadableFormatVersion || version > kFormatVersion) {
     throw IoError(file.string() + ": format_version " + std::to_string(version) +
-                  " is not supported (this build reads version " + std::to_string(kFormatVersion) +
-                  ")");
+                  " is not supported (this build reads versions " +
+                  std::to_string(kOldestReadableFormatVersion) + " to " +
+                  std::to_string(kFormatVersion) + ")");
   }
   Dataset d;
   d.git_commit = r.read_attribute("/", "skinlab_git_commit");

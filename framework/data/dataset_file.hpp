@@ -23,8 +23,11 @@
 
 namespace skinlab::data {
 
-/// Version of the layout written by this build; a file with another version is rejected.
-inline constexpr std::int64_t kFormatVersion = 1;
+/// Version of the layout written by this build. Version 2 added the optional per-character
+/// `leaf_tips`; a version-1 file (which has none: zero-length helper bones) is still read, any
+/// other version is rejected.
+inline constexpr std::int64_t kFormatVersion = 2;
+inline constexpr std::int64_t kOldestReadableFormatVersion = 1;
 
 /// What one distance type gives a character (HeterSkinNet Sec. 3.2: the top-K candidate bones of
 /// every vertex and 1/D as a vertex attribute). K is min(top_k, #B).
@@ -64,6 +67,9 @@ struct PreparedCharacter {
   std::vector<int> parents;              ///< #J parent index, −1 for the root
   RowMatrixXd joints;                    ///< #J×3 joint positions, metres
   RowMatrixXi bones;                     ///< #B×2 (start, end) joints; start = end: helper bone
+  /// #J×3 or empty: the end of each leaf joint's helper bone (Skeleton::leaf_tips,
+  /// distances/leaf_bones.hpp); empty: zero-length helper bones, the paper's construction.
+  RowMatrixXd leaf_tips;
   geometry::SparseWeights weights;       ///< #V×#J artist weights, rows sum to 1
   /// #V_orig: the vertex of V that every vertex of the source mesh became (merge map; the first
   /// vertices of V are the merged originals, subdivision only appends).
@@ -88,6 +94,10 @@ struct PreparedCharacter {
   int num_vertices() const { return static_cast<int>(V.rows()); }
   int num_joints() const { return static_cast<int>(joint_names.size()); }
   int num_bones() const { return static_cast<int>(bones.rows()); }
+  /// The character's skeleton (names, parents, joint positions and leaf tips). Validates it and
+  /// throws IoError naming the character when its `bones()` are not the stored `bones` (a file
+  /// written with another bone convention).
+  geometry::Skeleton rig() const;
 };
 
 /// Index lists into Dataset::characters.
@@ -115,7 +125,8 @@ void write_dataset(const std::filesystem::path& file, const Dataset& dataset,
 /// missing file, a file that is not HDF5 or is truncated, a missing `format_version` (a foreign
 /// file) or a version other than kFormatVersion, a missing dataset, a wrong shape, an index out
 /// of range (faces ≥ #V, bones or CSR columns ≥ #J, parents, top-K ≥ #B, edges, Laplacian,
-/// vertex map, split indices ≥ #characters), inconsistent CSR arrays and non-finite values.
+/// vertex map, split indices ≥ #characters), inconsistent CSR arrays, leaf tips that are not
+/// #J×3, and non-finite values.
 Dataset read_dataset(const std::filesystem::path& file);
 
 }  // namespace skinlab::data

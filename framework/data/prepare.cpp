@@ -218,12 +218,13 @@ PrepareReport prepare_dataset(const PrepareConfig& config, const PrepareOptions&
     (reused[i] ? report.reused : report.computed) += 1;
   }
   {
-    std::vector<std::string> group, skeleton;
+    std::vector<std::string> group, skeleton, source;
     for (const auto& c : dataset.characters) {
       group.push_back(c.group);
       skeleton.push_back(c.skeleton);
+      source.push_back(c.source);
     }
-    dataset.splits = make_splits(group, skeleton, config.splits);
+    dataset.splits = make_splits(group, skeleton, source, config.splits);
     for (const auto& [name, split] : dataset.splits) {
       spdlog::info("split {}: {} train, {} val, {} test", name, split.train.size(),
                    split.val.size(), split.test.size());

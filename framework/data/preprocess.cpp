@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <limits>
 #include <numeric>
 
@@ -13,6 +14,7 @@
 #include "framework/geometry/normalize.hpp"
 #include "framework/geometry/one_ring.hpp"
 #include "framework/geometry/subdivide.hpp"
+#include "framework/geometry/weightless_leaves.hpp"
 
 namespace skinlab::data {
 
@@ -25,14 +27,30 @@ PreprocessOptions PreprocessOptions::from(const config::Node& node) {
   f.optional("top_k", o.top_k);
   f.optional("geodesic_radius", o.geodesic_radius);
   f.optional("geodesic_max_neighbours", o.geodesic_max_neighbours);
+  o.leaf_bones = distances::LeafBoneOptions::from(f.section("leaf_bones"));
+  f.optional("drop_weightless_leaves", o.drop_weightless_leaves);
+  f.optional("drop_seed", o.drop_seed);
   f.check(o.merge_tolerance >= 0, "merge_tolerance", "must be ≥ 0");
   f.check(o.min_vertices >= 0, "min_vertices", "must be ≥ 0");
   f.check(o.max_vertices >= o.min_vertices, "max_vertices", "must be ≥ min_vertices");
   f.check(o.top_k >= 1, "top_k", "must be ≥ 1");
   f.check(o.geodesic_radius > 0, "geodesic_radius", "must be positive");
   f.check(o.geodesic_max_neighbours >= 0, "geodesic_max_neighbours", "must be ≥ 0");
+  f.check(o.drop_weightless_leaves >= 0 && o.drop_weightless_leaves <= 1,
+          "drop_weightless_leaves", "must be a probability in [0, 1]");
   f.finish();
   return o;
+}
+
+bool drops_weightless_leaves(const PreprocessOptions& options, const std::string& name) {
+  if (options.drop_weightless_leaves <= 0) return false;
+  // FNV-1a over the seed's bytes and the name: fixed across platforms, unlike std::hash.
+  std::uint64_t h = 14695981039346656037ull;
+  const auto mix = [&h](unsigned char byte) { h = (h ^ byte) * 1099511628211ull; };
+  for (int i = 0; i < 8; ++i) mix(static_cast<unsigned char>(options.drop_seed >> (8 * i)));
+  for (unsigned char ch : name) mix(ch);
+  const double u = static_cast<double>(h >> 11) / static_cast<double>(1ull << 53);
+  return u < options.drop_weightless_leaves;
 }
 
 void top_k_bones(const Eigen::MatrixXd& D, int k, RowMatrixXi& index, RowMatrixXf& distance) {
@@ -130,6 +148,27 @@ PreparedCharacter preprocess(const datasets::SourceCharacter& source,
   const bool weighted = c.has_weights();
   if (!weighted && mode.require_weights) throw Error(where + ": character has no skin weights");
 
+  // 0. The other convention of skeleton ends, for a share of the characters.
+  std::vector<datasets::Animation> animations = source.animations;
+  if (weighted && drops_weightless_leaves(options, c.name)) {
+    const std::vector<int> kept = geometry::drop_weightless_leaves(c);
+    const auto keep = [&kept](const std::vector<Eigen::Isometry3d>& per_joint) {
+      std::vector<Eigen::Isometry3d> out;
+      for (int j : kept) {
+        if (j < static_cast<int>(per_joint.size())) {
+          out.push_back(per_joint[static_cast<std::size_t>(j)]);
+        }
+      }
+      return out;
+    };
+    const std::size_t before = source.character.skeleton.names.size();
+    for (auto& a : animations) {  // clips follow the kept joints; a clip of another size stays
+      if (a.bind.size() != before) continue;  // as it is (and is reported below)
+      a.bind = keep(a.bind);
+      for (auto& frame : a.frames) frame = keep(frame);
+    }
+  }
+
   // 1. Normalise.
   geometry::NormalizeOptions normalize_options;
   normalize_options.source_up = source.up;
@@ -151,6 +190,8 @@ PreparedCharacter preprocess(const datasets::SourceCharacter& source,
     W.makeCompressed();
   }
   const geometry::Mesh& mesh = sub.mesh;
+  // 3b. Leaf bones on the final mesh (subdivision does not move the surface).
+  distances::place_leaf_bones(mesh, c.skeleton, options.leaf_bones, where);
   lap(times != nullptr ? &times->normalise : nullptr);
 
   PreparedCharacter out;
@@ -160,6 +201,7 @@ PreparedCharacter preprocess(const datasets::SourceCharacter& source,
   out.joint_names = c.skeleton.names;
   out.parents = c.skeleton.parents;
   out.joints = c.skeleton.positions;
+  out.leaf_tips = c.skeleton.leaf_tips;
   const auto bones = c.skeleton.bones();
   out.bones.resize(static_cast<Eigen::Index>(bones.size()), 2);
   for (std::size_t b = 0; b < bones.size(); ++b) out.bones.row(b) << bones[b].start, bones[b].end;
@@ -222,7 +264,7 @@ PreparedCharacter preprocess(const datasets::SourceCharacter& source,
   out.licence = source.licence;
   out.attribution = source.attribution;
   out.skeleton = source.skeleton;
-  for (const auto& a : source.animations) {
+  for (const auto& a : animations) {
     out.animations.push_back(convert(a, sim.matrix(), c.skeleton.num_joints(), where));
   }
   return out;

@@ -3,6 +3,8 @@
 /// Preprocessing of one character as HeterSkinNet (Pan et al. 2021) Sec. 4.1, plus everything a
 /// network needs per character (Sec. 3.2–3.4), computed once and stored in the dataset file:
 ///
+/// 0. with probability `drop_weightless_leaves`, remove the character's weightless end joints
+///    (geometry/weightless_leaves.hpp);
 /// 1. normalise: Y up, 1 m tall, feet at y = 0, x/z centred (geometry/normalize.hpp); the
 ///    similarity is kept (PreparedCharacter::normalisation);
 /// 2. merge vertices at the same position (geometry/merge_vertices.hpp); weights of merged
@@ -10,6 +12,8 @@
 /// 3. subdivide meshes below `min_vertices` into [min_vertices, max_vertices] (1K–5K in the
 ///    paper; geometry/subdivide.hpp) with weights interpolated linearly, W' = S · W (rows still
 ///    sum to 1 because the rows of S do);
+/// 3b. place the leaf joints' bones (`leaf_bones`: the paper's zero-length helpers, or bones
+///    with extent, distances/leaf_bones.hpp), so every distance sees the same bone geometry;
 /// 4. per distance type of the config: D (#V×#B), the top-K candidate bones per vertex (K = 3,
 ///    Sec. 3.2) with their distances, and bone-level targets over the K candidates;
 /// 5. one-ring edges (Eq. 2, N_m), geodesic neighbour edges (radius 0.06, at most 10; N_g) and
@@ -33,6 +37,7 @@
 #include "framework/core/config.hpp"
 #include "framework/data/dataset_file.hpp"
 #include "framework/distances/distance.hpp"
+#include "framework/distances/leaf_bones.hpp"
 
 namespace skinlab::data {
 
@@ -43,6 +48,16 @@ struct PreprocessOptions {
   int top_k = 3;                  ///< candidate bones per vertex (Sec. 3.2: K = 3)
   double geodesic_radius = 0.06;  ///< metres (Sec. 3.3)
   int geodesic_max_neighbours = 10;
+  /// Where a leaf joint's bone ends (distances/leaf_bones.hpp): `helper`, the paper's
+  /// zero-length bone (the default, so the paper's tables stay reproducible), or `extended`.
+  distances::LeafBoneOptions leaf_bones;
+  /// Probability in [0, 1] that a character's weightless end joints are removed before
+  /// everything else (geometry/weightless_leaves.hpp), so that a dataset mixes skeletons whose
+  /// leaves carry weight with skeletons whose leaves do not. Decided per character from its
+  /// name and `drop_seed`, so a preparation is repeatable. Characters without weights (to
+  /// predict for) are never changed. 0: off (the paper).
+  double drop_weightless_leaves = 0.0;
+  std::int64_t drop_seed = 0;
 
   /// Decodes a `preprocess:` map (every field optional); errors name the file, line and key.
   static PreprocessOptions from(const config::Node& node);
@@ -78,7 +93,11 @@ struct PreprocessTimes {
   double graph = 0;      ///< step 5: one-ring and geodesic edges, Laplacian
 };
 
-/// Runs steps 1–5 on `source` (which must carry weights unless `mode.require_weights` is
+/// True when `drop_weightless_leaves` applies to the character `name` (a hash of the name and
+/// `drop_seed` against the probability; the same answer on every machine).
+bool drops_weightless_leaves(const PreprocessOptions& options, const std::string& name);
+
+/// Runs steps 0–5 on `source` (which must carry weights unless `mode.require_weights` is
 /// false). Throws (GeometryError, IoError) with the character's name in the message when any
 /// step fails. `times`, when given, receives the time of each step.
 PreparedCharacter preprocess(const datasets::SourceCharacter& source,

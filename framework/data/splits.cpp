@@ -27,6 +27,18 @@ SplitOptions SplitOptions::from(const config::Node& node) {
   f.check(std::abs(sum - 1) < 1e-6, "fractions", "must sum to 1");
   std::copy(fractions.begin(), fractions.end(), o.fractions.begin());
   f.optional("heldout_skeletons", o.heldout_skeletons);
+  const config::Node leave = f.section("leave_out_sources");
+  if (leave.exists() && !leave.is_null()) {
+    if (!leave.is_map()) leave.fail("expected a map: split name → list of sources");
+    for (const auto& name : leave.keys()) {
+      auto sources = leave[name].as<std::vector<std::string>>();
+      if (sources.empty()) leave[name].fail("needs at least one source");
+      if (name.empty() || name.find('/') != std::string::npos) {
+        leave[name].fail("a split name must be non-empty and have no '/'");
+      }
+      o.leave_out_sources.emplace(name, std::move(sources));
+    }
+  }
   f.finish();
   return o;
 }
@@ -78,10 +90,12 @@ Split split_by_group(const std::vector<int>& members, const std::vector<std::str
 
 std::map<std::string, Split> make_splits(const std::vector<std::string>& groups,
                                          const std::vector<std::string>& skeletons,
+                                         const std::vector<std::string>& sources,
                                          const SplitOptions& options) {
-  if (groups.size() != skeletons.size()) {
+  if (groups.size() != skeletons.size() || groups.size() != sources.size()) {
     throw Error("make_splits: " + std::to_string(groups.size()) + " groups but " +
-                std::to_string(skeletons.size()) + " skeleton families");
+                std::to_string(skeletons.size()) + " skeleton families and " +
+                std::to_string(sources.size()) + " sources");
   }
   std::map<std::string, Split> out;
   const int n = static_cast<int>(groups.size());
@@ -90,32 +104,58 @@ std::map<std::string, Split> make_splits(const std::vector<std::string>& groups,
   std::mt19937_64 rng(options.seed);
   out["random"] = split_by_group(all, groups, options.fractions, rng);
 
-  if (!options.heldout_skeletons.empty()) {
-    const std::set<std::string> present(skeletons.begin(), skeletons.end());
-    for (const auto& family : options.heldout_skeletons) {
-      if (!present.count(family)) {
-        std::string list;
-        for (const auto& p : present) list += (list.empty() ? "" : ", ") + p;
-        throw Error("splits.heldout_skeletons: no character has skeleton family '" + family +
-                    "'; families present: " + list);
-      }
-    }
-    const std::set<std::string> held(options.heldout_skeletons.begin(),
-                                     options.heldout_skeletons.end());
+  // Test = the characters `held` selects; train / val from the rest in the train : val ratio.
+  const auto hold_out = [&](const std::vector<bool>& held, std::uint64_t seed,
+                            const std::string& what) {
     std::vector<int> rest, test;
-    for (int i = 0; i < n; ++i) {
-      (held.count(skeletons[static_cast<std::size_t>(i)]) ? test : rest).push_back(i);
-    }
-    if (rest.empty()) {
-      throw Error("splits.heldout_skeletons: holding out every family leaves nothing to train on");
-    }
+    for (int i = 0; i < n; ++i) (held[static_cast<std::size_t>(i)] ? test : rest).push_back(i);
+    if (rest.empty()) throw Error(what + ": holding it out leaves nothing to train on");
     const double tv = options.fractions[0] + options.fractions[1];
     std::array<double, 3> ratio{tv > 0 ? options.fractions[0] / tv : 1.0,
                                 tv > 0 ? options.fractions[1] / tv : 0.0, 0.0};
-    std::mt19937_64 rng2(options.seed + 1);
+    std::mt19937_64 rng2(seed);
     Split split = split_by_group(rest, groups, ratio, rng2);
     split.test = test;
-    out["heldout_skeleton"] = split;
+    return split;
+  };
+  const auto require_present = [](const std::vector<std::string>& values,
+                                  const std::string& value, const std::string& what,
+                                  const std::string& kind) {
+    const std::set<std::string> present(values.begin(), values.end());
+    if (present.count(value)) return;
+    std::string list;
+    for (const auto& p : present) list += (list.empty() ? "" : ", ") + p;
+    throw Error(what + " '" + value + "'; " + kind + " present: " + list);
+  };
+
+  if (!options.heldout_skeletons.empty()) {
+    for (const auto& family : options.heldout_skeletons) {
+      require_present(skeletons, family,
+                      "splits.heldout_skeletons: no character has skeleton family", "families");
+    }
+    const std::set<std::string> families(options.heldout_skeletons.begin(),
+                                         options.heldout_skeletons.end());
+    std::vector<bool> held(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) held[i] = families.count(skeletons[static_cast<std::size_t>(i)]) > 0;
+    out["heldout_skeleton"] = hold_out(held, options.seed + 1, "splits.heldout_skeletons");
+  }
+
+  std::uint64_t offset = 2;
+  for (const auto& [name, left_out] : options.leave_out_sources) {
+    const std::string what = "splits.leave_out_sources." + name;
+    for (const auto& source : left_out) {
+      require_present(sources, source, what + ": no character comes from source", "sources");
+    }
+    const std::set<std::string> chosen(left_out.begin(), left_out.end());
+    std::set<std::string> test_groups;
+    for (int i = 0; i < n; ++i) {
+      if (chosen.count(sources[static_cast<std::size_t>(i)])) {
+        test_groups.insert(groups[static_cast<std::size_t>(i)]);
+      }
+    }
+    std::vector<bool> held(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) held[i] = test_groups.count(groups[static_cast<std::size_t>(i)]) > 0;
+    out["leave_out_" + name] = hold_out(held, options.seed + offset++, what);
   }
   return out;
 }

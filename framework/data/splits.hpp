@@ -11,6 +11,12 @@
 ///   skeleton family is listed goes to test; the others are split into train / val by groups as
 ///   above, in the ratio of the train and val fractions. It measures generalisation to skeletons
 ///   never seen in training (e.g. no elephant and no bird in training).
+/// - `leave_out_<name>`, one per entry of `leave_out_sources` (name → source keys): every
+///   character of those sources goes to test, the others are split into train / val as above.
+///   A variant group with a member in a left-out source goes to test whole, so a near-copy of a
+///   test character in another source (the cleaning groups duplicates across sources) never
+///   trains. It measures generalisation to a game never seen in training, the project's proxy
+///   for a user's own character.
 ///
 /// The shuffle is our own Fisher–Yates over std::mt19937_64 with an explicit integer draw, so a
 /// seed gives the same splits with every standard library.
@@ -30,16 +36,19 @@ struct SplitOptions {
   std::uint64_t seed = 0;
   std::array<double, 3> fractions{0.7, 0.1, 0.2};  ///< train, val, test; sum 1
   std::vector<std::string> heldout_skeletons;      ///< skeleton families only in test
+  /// split name → sources (SourceCharacter::source) whose characters form its test part
+  std::map<std::string, std::vector<std::string>> leave_out_sources;
 
   /// Decodes a `splits:` map (every field optional); errors name the file, line and key.
   static SplitOptions from(const config::Node& node);
 };
 
-/// Splits characters given their group and skeleton family (parallel lists) as the file
-/// comment says. Throws Error when a held-out family is not among `skeletons` (listing those
-/// present) or when held-out families would leave no character for training.
+/// Splits characters given their group, skeleton family and source (parallel lists) as the file
+/// comment says. Throws Error when a held-out family or left-out source is not present (listing
+/// those present) or when holding it out would leave no character for training.
 std::map<std::string, Split> make_splits(const std::vector<std::string>& groups,
                                          const std::vector<std::string>& skeletons,
+                                         const std::vector<std::string>& sources,
                                          const SplitOptions& options);
 
 }  // namespace skinlab::data

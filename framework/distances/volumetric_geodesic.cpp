@@ -201,7 +201,7 @@ Eigen::MatrixXd VolumetricGeodesic::compute(const geometry::Mesh& mesh,
   std::vector<BoneEnds> ends(nb);
   for (int i = 0; i < nb; ++i) {
     ends[i].a = skeleton.positions.row(bones[i].start).transpose();
-    ends[i].b = skeleton.positions.row(bones[i].end).transpose();
+    ends[i].b = skeleton.bone_end(bones[i]);
     if ((ends[i].b - ends[i].a).squaredNorm() < 1e-8) {
       ends[i].samples = {ends[i].a};
     } else {

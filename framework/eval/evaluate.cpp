@@ -1,5 +1,8 @@
 #include "framework/eval/evaluate.hpp"
 
+#include <cmath>
+#include <limits>
+
 #include "framework/core/error.hpp"
 #include "framework/core/registry.hpp"
 
@@ -42,6 +45,7 @@ std::string join_names(const std::map<std::string, double>& values) {
 std::map<std::string, double> mean_over_characters(
     const std::vector<std::map<std::string, double>>& per_character) {
   std::map<std::string, double> sum;
+  std::map<std::string, long> counted;  // characters for which a value is defined (not NaN)
   if (per_character.empty()) return sum;
   for (std::size_t c = 0; c < per_character.size(); ++c) {
     const auto& values = per_character[c];
@@ -55,9 +59,15 @@ std::map<std::string, double> mean_over_characters(
                   join_names(values) + " but character 0 reports " +
                   join_names(per_character.front()));
     }
-    for (const auto& [name, value] : values) sum[name] += value;
+    for (const auto& [name, value] : values) {
+      sum[name] += std::isnan(value) ? 0.0 : value;
+      if (!std::isnan(value)) ++counted[name];
+    }
   }
-  for (auto& [name, value] : sum) value /= static_cast<double>(per_character.size());
+  for (auto& [name, value] : sum) {
+    value = counted[name] > 0 ? value / static_cast<double>(counted[name])
+                              : std::numeric_limits<double>::quiet_NaN();
+  }
   return sum;
 }
 

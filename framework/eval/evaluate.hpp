@@ -36,7 +36,9 @@ std::vector<std::shared_ptr<Metric>> make_metrics(const config::Node& list);
 /// The mean of every named value over the characters (one map per character). Every map must
 /// carry the same names: otherwise throws Error naming the first character whose names differ
 /// from the first character's, with both name lists. An empty input gives an empty map. A NaN
-/// value makes its mean NaN.
+/// value (a metric undefined for that character, e.g. dominant_joint's `leaf_to_parent` for a
+/// character without leaf-dominated vertices) is left out of its mean; a value NaN for every
+/// character has a NaN mean.
 std::map<std::string, double> mean_over_characters(
     const std::vector<std::map<std::string, double>>& per_character);
 

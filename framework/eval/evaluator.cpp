@@ -61,28 +61,12 @@ std::map<std::string, double> mean_values(const std::vector<CharacterResult>& ch
 namespace {
 
 /// The prepared character's mesh and skeleton in the normalised frame, for a binder. Throws
-/// Error when the skeleton's bone order differs from the stored bones (a dataset written by
-/// another bone convention).
+/// when the skeleton's bone order differs from the stored bones (PreparedCharacter::skeleton).
 std::pair<geometry::Mesh, geometry::Skeleton> geometry_of(const data::PreparedCharacter& c) {
   geometry::Mesh mesh;
   mesh.V = c.V;
   mesh.F = c.F;
-  geometry::Skeleton skeleton;
-  skeleton.names = c.joint_names;
-  skeleton.positions = c.joints;
-  skeleton.parents = c.parents;
-  skeleton.validate(c.name);
-  const auto bones = skeleton.bones();
-  bool same = static_cast<Eigen::Index>(bones.size()) == c.bones.rows();
-  for (std::size_t b = 0; same && b < bones.size(); ++b) {
-    const auto i = static_cast<Eigen::Index>(b);
-    same = bones[b].start == c.bones(i, 0) && bones[b].end == c.bones(i, 1);
-  }
-  if (!same) {
-    throw Error(c.name + ": the stored bones are not in Skeleton::bones() order; re-prepare "
-                "the dataset with this build");
-  }
-  return {std::move(mesh), std::move(skeleton)};
+  return {std::move(mesh), c.rig()};
 }
 
 /// #V×#B float32 bone weights of a binder, checked against the Binder contract.

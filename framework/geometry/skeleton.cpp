@@ -46,11 +46,16 @@ std::vector<Bone> Skeleton::bones() const {
   return out;
 }
 
+Eigen::Vector3d Skeleton::bone_end(const Bone& b) const {
+  if (b.helper && leaf_tips.rows() > 0) return leaf_tips.row(b.start).transpose();
+  return positions.row(b.end).transpose();
+}
+
 Eigen::MatrixXd Skeleton::bone_segments() const {
   const auto list = bones();
   Eigen::MatrixXd out(list.size(), 6);
   for (std::size_t b = 0; b < list.size(); ++b) {
-    out.row(b) << positions.row(list[b].start), positions.row(list[b].end);
+    out.row(b) << positions.row(list[b].start), bone_end(list[b]).transpose();
   }
   return out;
 }
@@ -77,6 +82,18 @@ void Skeleton::validate(const std::string& source) const {
     if (parents[j] < -1 || parents[j] >= n || parents[j] == j) {
       throw GeometryError(at + "joint '" + names[j] + "' has an invalid parent index " +
                           std::to_string(parents[j]));
+    }
+  }
+  if (leaf_tips.size() > 0 && (leaf_tips.rows() != n || leaf_tips.cols() != 3)) {
+    throw GeometryError(at + "leaf tips are " + std::to_string(leaf_tips.rows()) + "×" +
+                        std::to_string(leaf_tips.cols()) + " for " + std::to_string(n) +
+                        " joints (expected " + std::to_string(n) + "×3)");
+  }
+  if (leaf_tips.size() > 0 && !leaf_tips.allFinite()) {
+    for (int j = 0; j < n; ++j) {
+      if (!leaf_tips.row(j).allFinite()) {
+        throw GeometryError(at + "the leaf tip of joint '" + names[j] + "' is not finite");
+      }
     }
   }
   std::vector<int> roots;

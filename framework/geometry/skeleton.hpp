@@ -11,8 +11,10 @@
 namespace skinlab::geometry {
 
 /// A bone runs from joint `start` (the parent) to joint `end` (the child). A helper bone is the
-/// zero-length bone added at every leaf joint "for skinning at the end of limbs" (HeterSkinNet
-/// Sec. 3.2; RigNet's virtual leaf bones): `start == end`.
+/// bone added at every leaf joint "for skinning at the end of limbs" (HeterSkinNet Sec. 3.2;
+/// RigNet's virtual leaf bones): `start == end`. In the paper it has zero length; where
+/// Skeleton::leaf_tips is set it runs from the leaf joint to the leaf's tip
+/// (distances/leaf_bones.hpp).
 struct Bone {
   int start = -1;
   int end = -1;
@@ -23,6 +25,10 @@ struct Skeleton {
   std::vector<std::string> names;  ///< #J unique joint names
   Eigen::MatrixXd positions;       ///< #J×3 joint positions in the mesh's frame
   std::vector<int> parents;        ///< #J parent joint index; -1 for the root
+  /// #J×3 or empty. Empty: every helper bone has zero length (the paper). Set: the helper bone of
+  /// leaf joint j ends at row j (distances/leaf_bones.hpp); rows of joints with children are not
+  /// used (by convention the joint's own position).
+  Eigen::MatrixXd leaf_tips;
 
   int num_joints() const { return static_cast<int>(names.size()); }
   /// Index of joint `name`, or -1.
@@ -37,12 +43,17 @@ struct Skeleton {
   /// that child if it is a leaf. A one-joint skeleton has a single helper bone.
   std::vector<Bone> bones() const;
 
-  /// #B×6 rows [start xyz, end xyz] of `bones()`, the bone attribute of HeterSkinNet Sec. 3.2.
+  /// #B×6 rows [start xyz, end xyz] of `bones()`, the bone attribute of HeterSkinNet Sec. 3.2;
+  /// a helper bone ends at its leaf tip when `leaf_tips` is set (bone_end).
   Eigen::MatrixXd bone_segments() const;
+  /// Where bone `b` ends: its end joint, or for a helper bone the leaf's tip when `leaf_tips` is
+  /// set (the joint itself otherwise).
+  Eigen::Vector3d bone_end(const Bone& b) const;
 
   /// Throws GeometryError, prefixed by `source`, for: no joints, sizes that disagree, empty or
   /// duplicate joint names, non-finite positions, parent indices out of range, no root, several
-  /// roots, and cycles (naming the joints involved).
+  /// roots, cycles (naming the joints involved), and leaf tips that are neither empty nor #J×3
+  /// finite values.
   void validate(const std::string& source) const;
 
   /// Builds a skeleton from joint names, positions and parent names ("" for the root) and

@@ -21,8 +21,19 @@ struct MeanSd {
   double mean = 0, sd = 0;
 };
 
-MeanSd stats_of(const std::vector<double>& x) {
+/// The values of `all` that are not NaN (a metric undefined for a character, evaluate.hpp).
+std::vector<double> defined(const std::vector<double>& all) {
+  std::vector<double> x;
+  for (double v : all) {
+    if (!std::isnan(v)) x.push_back(v);
+  }
+  return x;
+}
+
+MeanSd stats_of(const std::vector<double>& all) {
+  const std::vector<double> x = defined(all);
   MeanSd s;
+  if (x.empty()) return {std::nan(""), std::nan("")};
   for (double v : x) s.mean += v;
   s.mean /= static_cast<double>(x.size());
   if (x.size() > 1) {
@@ -203,7 +214,13 @@ std::string make_table(const std::vector<RunResult>& runs, const TableOptions& o
     for (std::size_t r = 1; r < runs.size(); ++r) {
       std::vector<std::string> row{name(runs[r])};
       for (const auto& m : options.metrics) {
-        const auto a = eval::one_way_anova({ref.values.at(m), runs[r].values.at(m)});
+        // A metric undefined for some characters (NaN) is tested on the others.
+        const auto x = defined(ref.values.at(m)), y = defined(runs[r].values.at(m));
+        if (x.empty() || y.empty() || x.size() + y.size() < 3) {
+          row.push_back("n/a");
+          continue;
+        }
+        const auto a = eval::one_way_anova({x, y});
         row.push_back(fmt::format("{:.4f} ({})", a.F, p_text(a.p)));
       }
       anova.push_back(std::move(row));

@@ -64,18 +64,7 @@ CharacterTensors to_tensors(const PreparedCharacter& character, const std::strin
   t.targets = torch::where(sums > 0, raw / sums.clamp_min(1e-30), torch::zeros_like(raw));
 
   // Full bone weights by the preprocessing's own rule (preprocess.hpp), from D as stored.
-  geometry::Skeleton skeleton;
-  skeleton.names = character.joint_names;
-  skeleton.parents = character.parents;
-  skeleton.positions = character.joints;
-  const auto bones = skeleton.bones();
-  bool same_bones = static_cast<Eigen::Index>(bones.size()) == nb;
-  for (Eigen::Index b = 0; same_bones && b < nb; ++b) {
-    same_bones = bones[b].start == character.bones(b, 0) && bones[b].end == character.bones(b, 1);
-  }
-  if (!same_bones) {
-    throw IoError(where + ": the stored bones are not the skeleton's bones in RigNet's order");
-  }
+  const geometry::Skeleton skeleton = character.rig();
   if (character.weights.rows() == 0 && character.weights.cols() == 0) {
     // A character prepared for prediction (preprocess.hpp, PreprocessMode): no ground truth.
     t.bone_weights = torch::Tensor();
@@ -87,11 +76,7 @@ CharacterTensors to_tensors(const PreparedCharacter& character, const std::strin
     t.bone_weights = to_float(RowMatrixXd(Wb));
   }
 
-  RowMatrixXd segments(nb, 6);
-  for (Eigen::Index b = 0; b < nb; ++b) {
-    segments.row(b) << character.joints.row(character.bones(b, 0)),
-        character.joints.row(character.bones(b, 1));
-  }
+  const RowMatrixXd segments = skeleton.bone_segments();  // Sec. 3.2's bone attribute
   t.bones = to_float(segments);
   t.bone_joints = to_long(character.bones);
   t.one_ring = to_long(character.one_ring_edges);

@@ -10,6 +10,7 @@
 #include "framework/core/error.hpp"
 #include "framework/data/clean.hpp"
 #include "framework/data/splits.hpp"
+#include "tests/test_util.hpp"
 
 namespace skinlab::data {
 namespace {
@@ -168,10 +169,23 @@ TEST(Splits, NeverDivideAGroupAndApproachTheFractions) {
       skeletons.push_back("family" + std::to_string(g % 4));
     }
   }
+  // Sources: groups 0–4 come from "b", the rest from "a"; group 5 has a copy in "b" too.
+  std::vector<std::string> sources;
+  for (const auto& g : groups) {
+    const int k = std::stoi(g.substr(1));
+    sources.push_back(k < 5 ? "b" : "a");
+  }
+  for (std::size_t i = 0; i < groups.size(); ++i) {
+    if (groups[i] == "g5") {
+      sources[i] = "b";
+      break;
+    }
+  }
   SplitOptions options;
   options.heldout_skeletons = {"family3"};
-  const auto splits = make_splits(groups, skeletons, options);
-  ASSERT_EQ(splits.size(), 2u);
+  options.leave_out_sources = {{"b_only", {"b"}}};
+  const auto splits = make_splits(groups, skeletons, sources, options);
+  ASSERT_EQ(splits.size(), 3u);
   for (const auto& [name, s] : splits) {
     std::map<std::string, int> part_of_group;
     std::set<int> seen;
@@ -195,18 +209,25 @@ TEST(Splits, NeverDivideAGroupAndApproachTheFractions) {
   for (int i : h.test) EXPECT_EQ(skeletons[static_cast<std::size_t>(i)], "family3");
   for (int i : h.train) EXPECT_NE(skeletons[static_cast<std::size_t>(i)], "family3");
   EXPECT_FALSE(h.val.empty());
+  // Leaving out source "b": its characters are tested, and group g5 (one member in "b") whole.
+  const Split& l = splits.at("leave_out_b_only");
+  std::set<std::string> test_groups;
+  for (int i : l.test) test_groups.insert(groups[static_cast<std::size_t>(i)]);
+  EXPECT_EQ(test_groups, (std::set<std::string>{"g0", "g1", "g2", "g3", "g4", "g5"}));
+  for (int i : l.train) EXPECT_EQ(sources[static_cast<std::size_t>(i)], "a");
+  EXPECT_FALSE(l.val.empty());
 
   // Same seed, same splits; another seed, other splits.
-  EXPECT_EQ(make_splits(groups, skeletons, options).at("random").test, r.test);
+  EXPECT_EQ(make_splits(groups, skeletons, sources, options).at("random").test, r.test);
   options.seed = 7;
-  EXPECT_NE(make_splits(groups, skeletons, options).at("random").test, r.test);
+  EXPECT_NE(make_splits(groups, skeletons, sources, options).at("random").test, r.test);
 }
 
 TEST(Splits, UnknownHeldOutFamilyIsAnErrorListingTheFamilies) {
   SplitOptions options;
   options.heldout_skeletons = {"elephnt"};
   try {
-    make_splits({"a", "b"}, {"elephant", "horse"}, options);
+    make_splits({"a", "b"}, {"elephant", "horse"}, {"s", "s"}, options);
     FAIL() << "expected an error";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("'elephnt'; families present: elephant, horse"),
@@ -214,7 +235,16 @@ TEST(Splits, UnknownHeldOutFamilyIsAnErrorListingTheFamilies) {
         << e.what();
   }
   options.heldout_skeletons = {"elephant", "horse"};
-  EXPECT_THROW(make_splits({"a", "b"}, {"elephant", "horse"}, options), Error);
+  EXPECT_THROW(make_splits({"a", "b"}, {"elephant", "horse"}, {"s", "s"}, options), Error);
+  options.heldout_skeletons.clear();
+  options.leave_out_sources = {{"games", {"zeroad", "sumwars"}}};
+  testing::expect_error<Error>(
+      [&] { make_splits({"a", "b"}, {"elephant", "horse"}, {"zeroad", "folder"}, options); },
+      {"splits.leave_out_sources.games", "'sumwars'", "sources present: folder, zeroad"});
+  options.leave_out_sources = {{"all", {"zeroad", "folder"}}};
+  testing::expect_error<Error>(
+      [&] { make_splits({"a", "b"}, {"elephant", "horse"}, {"zeroad", "folder"}, options); },
+      {"leave_out_sources.all", "nothing to train on"});
 }
 
 TEST(Splits, OptionsAreValidated) {
@@ -225,6 +255,11 @@ TEST(Splits, OptionsAreValidated) {
   EXPECT_THROW(parse("fractions: [0.5, 0.1, 0.1]"), ConfigError);
   EXPECT_THROW(parse("fractions: [0.9, 0.1]"), ConfigError);
   EXPECT_THROW(parse("heldout: [bird]"), ConfigError);
+  const auto leave = parse("leave_out_sources: {ogre_games: [sumwars, opendungeons], zeroad: [zeroad]}");
+  EXPECT_EQ(leave.leave_out_sources.at("ogre_games"),
+            (std::vector<std::string>{"sumwars", "opendungeons"}));
+  EXPECT_THROW(parse("leave_out_sources: [zeroad]"), ConfigError);
+  EXPECT_THROW(parse("leave_out_sources: {none: []}"), ConfigError);
   EXPECT_THROW(CleaningOptions::from(config::Config::parse("min_bone: 3").root()), ConfigError);
 }
 

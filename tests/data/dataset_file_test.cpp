@@ -25,6 +25,9 @@ data::Dataset tiny_dataset() {
   d.characters = {testing::tiny_character("alpha"), testing::tiny_character("beta")};
   d.characters[1].animations.clear();
   d.characters[1].distances["hollow_dist"] = d.characters[1].distances["euclidean"];
+  // beta's leaf bones have extent (format version 2); alpha keeps the paper's zero-length ones.
+  d.characters[1].leaf_tips = d.characters[1].joints;
+  d.characters[1].leaf_tips.bottomRows(1).array() += 0.25;
   d.splits["random"] = {{0}, {}, {1}};
   d.splits["by_skeleton"] = {{1}, {0}, {}};
   d.excluded = {{"folder", "bad.fbx", "bad.fbx: cannot read"}, {"zeroad", "x.pmd", "no bones"}};
@@ -38,6 +41,7 @@ void expect_equal(const data::PreparedCharacter& a, const data::PreparedCharacte
   EXPECT_EQ(a.V, b.V);
   EXPECT_EQ(a.F, b.F);
   EXPECT_EQ(a.joint_names, b.joint_names);
+  EXPECT_EQ(a.leaf_tips, b.leaf_tips);
   EXPECT_EQ(a.parents, b.parents);
   EXPECT_EQ(a.joints, b.joints);
   EXPECT_EQ(a.bones, b.bones);
@@ -93,6 +97,34 @@ TEST(DatasetFile, RoundTrip) {
   EXPECT_EQ(r.excluded[1].reason, "no bones");
 }
 
+TEST(DatasetFile, VersionOneFilesReadWithZeroLengthHelperBones) {
+  TempDir dir;
+  data::Dataset d = tiny_dataset();
+  d.characters[1].leaf_tips.resize(0, 0);
+  data::write_dataset(dir / "v1.h5", d);
+  {  // what a version-1 writer left: the same layout without leaf tips
+    H5::H5File file((dir / "v1.h5").string(), H5F_ACC_RDWR);
+    H5::Attribute version = file.openAttribute("format_version");
+    const std::int64_t one = 1;
+    version.write(H5::PredType::NATIVE_INT64, &one);
+  }
+  const auto r = data::read_dataset(dir / "v1.h5");
+  EXPECT_EQ(r.characters[1].leaf_tips.size(), 0);
+  const auto rig = r.characters[1].rig();
+  for (const auto& b : rig.bones()) {
+    if (b.helper) EXPECT_TRUE(rig.bone_end(b).isApprox(rig.positions.row(b.start).transpose()));
+  }
+}
+
+TEST(DatasetFile, LeafTipsOfTheWrongShapeNameTheDataset) {
+  TempDir dir;
+  data::Dataset d = tiny_dataset();
+  d.characters[1].leaf_tips.conservativeResize(d.characters[1].leaf_tips.rows() - 1, 3);
+  data::write_dataset(dir / "t.h5", d);
+  expect_error<IoError>([&] { data::read_dataset(dir / "t.h5"); },
+                        {"t.h5", "'/characters/beta/leaf_tips'"});
+}
+
 TEST(DatasetFile, RealCharacterArraysAreChunkedAndCompressed) {
   TempDir dir;
   data::Dataset d;
@@ -124,11 +156,11 @@ TEST(DatasetFile, ForeignAndBrokenFilesAreNamed) {
                         {"foreign.h5", "not a skinlab dataset", "format_version"});
   {
     data::H5Writer w(dir / "future.h5");
-    w.write_attribute("/", "format_version", std::int64_t{2});
+    w.write_attribute("/", "format_version", std::int64_t{3});
     w.commit();
   }
   expect_error<IoError>([&] { data::read_dataset(dir / "future.h5"); },
-                        {"future.h5", "format_version 2 is not supported", "version 1"});
+                        {"future.h5", "format_version 3 is not supported", "versions 1 to 2"});
 
   // Truncated: a real dataset cut at half its size (as a crash during a copy would leave it).
   data::Dataset d = tiny_dataset();
@@ -210,7 +242,7 @@ TEST(DatasetFile, ReadableByH5py) {
   const std::string printed = read_file(out);
   ASSERT_EQ(status, 0) << printed;
   EXPECT_EQ(printed,
-            "1 ['alpha', 'beta'] (4, 3) [1, 3, 2] (4, 400) gzip True [1] CC0-1.0 (2, 3, 12)\n");
+            "2 ['alpha', 'beta'] (4, 3) [1, 3, 2] (4, 400) gzip True [1] CC0-1.0 (2, 3, 12)\n");
 }
 
 }  // namespace SKINLAB_UNITY_ID

@@ -65,7 +65,7 @@ TEST(MakeMetrics, RejectsBadListsTypesAndOptions) {
   expect_error<ConfigError>([&] { build("other: 1"); }, {"non-empty list of metrics"});
   expect_error<RegistryError>([&] { build("metrics:\n  - {type: avg_l2}\n"); },
                               {"m.yaml:2: metrics[0]: ", "unknown metric type 'avg_l2'",
-                               "known metric types: avg_l1, deformation_error, precision_recall"});
+                               "known metric types: avg_l1, deformation_error, dominant_joint, precision_recall"});
   expect_error<ConfigError>([&] { build("metrics:\n  - {type: avg_l1, prune: 2}\n"); },
                             {"m.yaml:2: metrics[0].prune: must be in [0, 1]"});
 }
@@ -76,7 +76,9 @@ TEST(MeanOverCharacters, AveragesEveryNameWithCharactersCountingEqually) {
                                           {{"precision", 0.0}, {"avg_l1", 0.0}}});
   EXPECT_EQ(mean, (std::map<std::string, double>{{"avg_l1", 0.25}, {"precision", 0.5}}));
   EXPECT_TRUE(mean_over_characters({}).empty());
-  EXPECT_TRUE(std::isnan(mean_over_characters({{{"a", 1.0}}, {{"a", std::nan("")}}}).at("a")));
+  // A value undefined for a character (NaN) is left out of its mean; all undefined: NaN.
+  EXPECT_EQ(mean_over_characters({{{"a", 1.0}}, {{"a", std::nan("")}}, {{"a", 0.5}}}).at("a"), 0.75);
+  EXPECT_TRUE(std::isnan(mean_over_characters({{{"a", std::nan("")}}, {{"a", std::nan("")}}}).at("a")));
 }
 
 TEST(MeanOverCharacters, DifferentNamesAreAnError) {

@@ -5,6 +5,7 @@
 
 #include "framework/core/registry.hpp"
 #include "framework/eval/metric.hpp"
+#include "framework/eval/value_display.hpp"
 #include "tests/eval/eval_fixtures.hpp"
 #include "tests/test_util.hpp"
 
@@ -39,7 +40,8 @@ TEST_P(EveryMetric, IdealValuesNamesAndDeterminism) {
   // Without pruning, a perfect prediction is exactly ideal.
   const auto raw = make_metric("{type: " + GetParam() + ", prune: 0}");
   for (const auto& [name, value] : (*raw)({gt, gt, &c})) {
-    const bool is_score = name == "precision" || name == "recall";
+    // A score (higher is better: precision, recall, dominant_joint) is 1, an error 0.
+    const bool is_score = value_display(name).higher_better;
     EXPECT_EQ(value, is_score ? 1.0 : 0.0) << name;
   }
   EXPECT_EQ((*metric)({pred, gt, &c}), (*metric)({pred, gt, &c}));

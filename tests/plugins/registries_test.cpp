@@ -27,7 +27,7 @@ TEST(Registry, ExactKeysOfEveryCategory) {
       {"model", {"heterskinnet", "neuroskinning", "rignet_skin"}},
       {"corrective_model", {"densegats", "neuroskinning"}},
       {"loss", {"kl", "laplacian_smoothing", "mse", "soft_cross_entropy"}},
-      {"metric", {"avg_l1", "deformation_error", "precision_recall"}},
+      {"metric", {"avg_l1", "deformation_error", "dominant_joint", "precision_recall"}},
       {"dataset", {"cube2", "folder", "nexuiz", "zeroad"}},
       {"binder", {"bone_heat", "geo_voxel"}},
       {"task", {"corrective", "sequence", "skinning"}},

@@ -1,0 +1,73 @@
+#pragma once
+/// \file
+/// Where the bone of a leaf joint ends: the paper's zero-length helper bone, or a bone with
+/// extent into the leaf's own region of the mesh.
+///
+/// **The paper's construction** (HeterSkinNet Sec. 3.2, "we add a virtual bone for every leaf
+/// joint for skinning at the end of limbs"; RigNet's virtual leaf bones) is a zero-length bone at
+/// the leaf joint. That point is also the end of the parent's bone, so every vertex–bone distance
+/// ties between the two (a point-to-segment distance is never smaller for a point than for a
+/// segment that ends at it): under every distance the parent bone is at least as near as the leaf,
+/// and a network sees two bones that differ only in their length. Where the artist weighted the
+/// leaf (a head, a hand, a foot, a tail tip: skeletons saved joint-only, as glTF and RigNet's rig
+/// text are), a network trained on skeletons that end in weightless end joints learns that the
+/// parent wins.
+///
+/// **`extended`** gives a leaf joint a bone from the joint along its parent bone's direction to
+/// where that ray leaves the mesh, at most `max_length` × the parent bone's length:
+///
+///     d   = (p_leaf − p_parent) / |p_leaf − p_parent|      (the nearest ancestor at another
+///                                                           position if the parent coincides)
+///     t*  = the nearest intersection of the ray p_leaf + t·d (t > 0) with the mesh surface
+///     tip = p_leaf + min(t*, max_length · |p_leaf − p_parent|) · d
+///
+/// Why this construction: the region a leaf joint skins lies beyond the joint, continuing the
+/// limb (the head above the neck joint, the hand past the wrist, the tail tip); the first surface
+/// crossing along the limb's direction is the end of that region for a joint inside the mesh,
+/// and the bound keeps a ray that runs along a thin part (or leaves through a far part of the
+/// body) from producing a bone longer than the limb's own last segment. It uses only what every
+/// rig has (joint positions and the mesh), so it is the same for a joint-only glTF, a rig text
+/// and a game skeleton with bone tails. A leaf joint with no intersection ahead (a joint outside
+/// the mesh pointing away from it, such as a weightless end marker) keeps a zero-length bone,
+/// as does a leaf whose every ancestor sits at its position or the root of a one-joint skeleton.
+/// The foot is its weak case: the ray along the shin meets the sole soon, so the foot's bone is
+/// short; it still separates the foot from the end of the shin.
+///
+/// The result is Skeleton::leaf_tips; bones, their order and the bone-level targets do not
+/// change (a leaf's weight is its helper bone's, data/preprocess.hpp), only the geometry that
+/// distances, binders and the bone attribute (Sec. 3.2) see.
+
+#include <Eigen/Core>
+#include <string>
+
+#include "framework/core/config.hpp"
+#include "framework/geometry/mesh.hpp"
+#include "framework/geometry/skeleton.hpp"
+
+namespace skinlab::distances {
+
+struct LeafBoneOptions {
+  enum class Kind { kHelper, kExtended };
+  Kind kind = Kind::kHelper;  ///< `helper` (the paper) or `extended` (this file's comment)
+  double max_length = 1.0;    ///< bound of an extended bone, × the parent bone's length; > 0
+
+  /// Decodes `leaf_bones: helper` / `leaf_bones: extended` or the map
+  /// `{type: extended, max_length: 1.0}`; errors name the config file, line and key.
+  static LeafBoneOptions from(const config::Node& node);
+  /// "helper" or "extended".
+  std::string name() const;
+};
+
+/// #J×3 leaf tips of `skeleton` on `mesh` (the `extended` construction above): row j is the tip
+/// of leaf joint j, and the joint's own position for every joint with children. Both in the same
+/// frame and units. Throws GeometryError (prefixed by `source`) for an invalid mesh or skeleton
+/// or `max_length` ≤ 0.
+Eigen::MatrixXd extended_leaf_tips(const geometry::Mesh& mesh, const geometry::Skeleton& skeleton,
+                                   double max_length, const std::string& source);
+
+/// Sets `skeleton.leaf_tips` as `options` asks: cleared for `helper`, extended_leaf_tips(...)
+/// for `extended`.
+void place_leaf_bones(const geometry::Mesh& mesh, geometry::Skeleton& skeleton,
+                      const LeafBoneOptions& options, const std::string& source);
+
+}  // namespace skinlab::distances

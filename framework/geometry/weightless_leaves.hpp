@@ -1,0 +1,25 @@
+#pragma once
+/// \file
+/// Removing the weightless end joints of a rig: the other convention of where a skeleton ends.
+///
+/// Game skeletons often end in joints that skin nothing (0 A.D.'s "head_end", bone-tail markers
+/// of Blender exports, IK targets), so the joint that carries the head's weight has a child and a
+/// real bone. Joint-only rigs (glTF, RigNet's rig text) usually end at the weighted joint itself.
+/// A model trained on one convention sees only one kind of leaf; training on both (preprocess's
+/// `drop_weightless_leaves`) shows it leaf joints that carry weight and leaf joints that do not.
+
+#include <vector>
+
+#include "framework/geometry/skin_weights.hpp"
+
+namespace skinlab::geometry {
+
+/// Removes, repeatedly, every leaf joint whose weight column is zero, until every leaf carries
+/// weight (or only the root is left); the root is never removed. Joint order is kept, parents
+/// and the weight columns are re-indexed, and leaf tips (if set) are dropped with their joints.
+/// Requires a validated character with weights. Returns the original indices of the joints
+/// kept, in order (every joint when nothing was removed), to re-index per-joint data such as
+/// animation transforms.
+std::vector<int> drop_weightless_leaves(Character& character);
+
+}  // namespace skinlab::geometry

@@ -1,0 +1,126 @@
+// Leaf bones: the paper's zero-length helper against the `extended` construction (ray along the
+// parent bone to the surface, bounded by a multiple of the parent's length), its options, and
+// what it changes for a distance.
+
+#include <gtest/gtest.h>
+
+#include "framework/core/registry.hpp"
+#include "framework/distances/distance.hpp"
+#include "framework/distances/leaf_bones.hpp"
+#include "tests/distances/shapes.hpp"
+#include "tests/test_util.hpp"
+
+namespace skinlab::distances {
+namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
+
+using skinlab::testing::expect_error;
+
+LeafBoneOptions parse(const std::string& yaml) {
+  return LeafBoneOptions::from(config::Config::parse(yaml, "p.yaml").root()["leaf_bones"]);
+}
+
+/// A 1 × 4 × 1 box (y from 0 to 4) with a chain up its axis: root at y = 0.5, a joint at 1.5
+/// and the leaf at 2.5. The ray from the leaf along the parent bone (+y) leaves the box at 4.
+struct Column {
+  geometry::Mesh mesh = testing::MeshBuilder().box({-0.5, 0, -0.5}, {0.5, 4, 0.5}, 3).build();
+  geometry::Skeleton skeleton;
+  Column() {
+    Eigen::MatrixXd joints(3, 3);
+    joints << 0, 0.5, 0, 0, 1.5, 0, 0, 2.5, 0;
+    skeleton = testing::chain(joints);
+  }
+};
+
+TEST(LeafBones, ExtendedEndsWhereTheRayLeavesTheMesh) {
+  Column c;
+  const Eigen::MatrixXd tips = extended_leaf_tips(c.mesh, c.skeleton, 2.0, "column");
+  ASSERT_EQ(tips.rows(), 3);
+  EXPECT_TRUE(tips.row(0).isApprox(c.skeleton.positions.row(0)));  // joints with children: own
+  EXPECT_TRUE(tips.row(1).isApprox(c.skeleton.positions.row(1)));  // position
+  EXPECT_NEAR(tips(2, 0), 0, 1e-12);
+  EXPECT_NEAR(tips(2, 1), 4.0, 1e-9);  // the top face
+  EXPECT_NEAR(tips(2, 2), 0, 1e-12);
+}
+
+TEST(LeafBones, ExtendedIsBoundedByTheParentLength) {
+  Column c;
+  // The parent bone is 1 long; at most 0.75 of it beyond the leaf, short of the top face.
+  const Eigen::MatrixXd tips = extended_leaf_tips(c.mesh, c.skeleton, 0.75, "column");
+  EXPECT_NEAR(tips(2, 1), 3.25, 1e-12);
+}
+
+TEST(LeafBones, LeafOutsideFacingAwayKeepsZeroLength) {
+  Column c;
+  c.skeleton.positions(2, 1) = 5.0;  // above the box, pointing further up: nothing ahead
+  const Eigen::MatrixXd tips = extended_leaf_tips(c.mesh, c.skeleton, 2.0, "column");
+  EXPECT_TRUE(tips.row(2).isApprox(c.skeleton.positions.row(2)));
+}
+
+TEST(LeafBones, CoincidentParentUsesTheNextAncestorsDirection) {
+  Column c;
+  c.skeleton.positions.row(1) = c.skeleton.positions.row(2);  // the parent sits on the leaf
+  const Eigen::MatrixXd tips = extended_leaf_tips(c.mesh, c.skeleton, 1.0, "column");
+  // Direction from the root (y = 0.5) up, bounded by that distance (2): 2.5 + 1.5 to the top.
+  EXPECT_NEAR(tips(2, 1), 4.0, 1e-9);
+}
+
+TEST(LeafBones, SkeletonSegmentsUseTheTipsAndHelperClearsThem) {
+  Column c;
+  place_leaf_bones(c.mesh, c.skeleton, parse("leaf_bones: extended"), "column");
+  const auto bones = c.skeleton.bones();
+  ASSERT_EQ(bones.size(), 3u);  // j0->j1, j1->j2, helper at j2
+  ASSERT_TRUE(bones[2].helper);
+  const Eigen::MatrixXd seg = c.skeleton.bone_segments();
+  EXPECT_NEAR(seg(2, 1), 2.5, 1e-12);  // starts at the leaf joint ...
+  EXPECT_NEAR(seg(2, 4), 3.5, 1e-9);   // ... ends at the default bound, 1 × the parent's length
+  EXPECT_NEAR(seg(1, 4), 2.5, 1e-12);  // other bones unchanged
+
+  // Under the paper's construction the helper is a point at the leaf, the end of the parent bone:
+  // a vertex above the leaf is as near to the parent bone as to the helper (the tie); with the
+  // extended bone it is nearer to the leaf's own bone.
+  const auto euclidean =
+      distance_registry().create(config::Config::parse("{type: euclidean}", "d.yaml").root());
+  const Eigen::MatrixXd D_extended = euclidean->compute(c.mesh, c.skeleton);
+  place_leaf_bones(c.mesh, c.skeleton, parse("leaf_bones: helper"), "column");
+  EXPECT_EQ(c.skeleton.leaf_tips.size(), 0);
+  const Eigen::MatrixXd D_helper = euclidean->compute(c.mesh, c.skeleton);
+  const int top = testing::nearest_vertex(c.mesh, {0, 4, 0});
+  EXPECT_DOUBLE_EQ(D_helper(top, 1), D_helper(top, 2));
+  EXPECT_LT(D_extended(top, 2), D_extended(top, 1));
+}
+
+TEST(LeafBones, Options) {
+  EXPECT_EQ(parse("x: 1").kind, LeafBoneOptions::Kind::kHelper);  // absent: the paper
+  EXPECT_EQ(parse("leaf_bones: helper").kind, LeafBoneOptions::Kind::kHelper);
+  const auto o = parse("leaf_bones: {type: extended, max_length: 0.5}");
+  EXPECT_EQ(o.kind, LeafBoneOptions::Kind::kExtended);
+  EXPECT_DOUBLE_EQ(o.max_length, 0.5);
+  EXPECT_EQ(o.name(), "extended");
+  expect_error<ConfigError>([] { parse("leaf_bones: longer"); },
+                                    {"p.yaml:1", "leaf_bones", "'helper'", "'extended'", "longer"});
+  expect_error<ConfigError>([] { parse("leaf_bones: {type: extended, max_length: 0}"); },
+                                    {"max_length", "must be positive"});
+  expect_error<ConfigError>([] { parse("leaf_bones: {max_length: 2}"); },
+                                    {"leaf_bones", "type"});
+  expect_error<ConfigError>([] { parse("leaf_bones: {type: extended, max_lenght: 2}"); },
+                                    {"max_lenght"});
+}
+
+TEST(LeafBones, BadInputIsNamed) {
+  Column c;
+  expect_error<geometry::GeometryError>(
+      [&] { extended_leaf_tips(c.mesh, c.skeleton, -1.0, "column.glb"); },
+      {"column.glb", "max_length"});
+  c.skeleton.leaf_tips = Eigen::MatrixXd::Zero(2, 3);
+  expect_error<geometry::GeometryError>([&] { c.skeleton.validate("rig.txt"); },
+                                        {"rig.txt", "leaf tips are 2×3 for 3 joints"});
+  c.skeleton.leaf_tips = Eigen::MatrixXd::Zero(3, 3);
+  c.skeleton.leaf_tips(1, 0) = std::nan("");
+  expect_error<geometry::GeometryError>([&] { c.skeleton.validate("rig.txt"); },
+                                        {"rig.txt", "leaf tip of joint 'j1'"});
+}
+
+}  // namespace SKINLAB_UNITY_ID
+}  // namespace
+}  // namespace skinlab::distances

@@ -1,0 +1,59 @@
+// drop_weightless_leaves: the other skeleton-end convention, removing weightless end joints.
+
+#include <gtest/gtest.h>
+
+#include "framework/geometry/weightless_leaves.hpp"
+
+namespace skinlab::geometry {
+namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
+
+/// root -> arm -> hand -> hand_end -> hand_end2 and root -> head, one vertex per weighted joint.
+Character rig(bool head_weighted) {
+  Character c;
+  c.name = "rig";
+  c.mesh.V = Eigen::MatrixXd::Random(3, 3);
+  c.mesh.F = Eigen::MatrixXi(1, 3);
+  c.mesh.F << 0, 1, 2;
+  Eigen::MatrixXd p(6, 3);
+  p << 0, 0, 0, 1, 0, 0, 2, 0, 0, 3, 0, 0, 4, 0, 0, 0, 1, 0;
+  c.skeleton = Skeleton::from_parent_names({"root", "arm", "hand", "hand_end", "hand_end2", "head"},
+                                           p, {"", "root", "arm", "hand", "hand_end", "root"},
+                                           "rig");
+  c.weights.resize(3, 6);
+  c.weights.insert(0, 1) = 1.0;                   // arm
+  c.weights.insert(1, 2) = 1.0;                   // hand
+  c.weights.insert(2, head_weighted ? 5 : 0) = 1.0;  // head, or the root
+  c.weights.makeCompressed();
+  return c;
+}
+
+TEST(DropWeightlessLeaves, RemovesChainsOfWeightlessEndJoints) {
+  Character c = rig(true);
+  c.skeleton.leaf_tips = c.skeleton.positions;
+  EXPECT_EQ(drop_weightless_leaves(c), (std::vector<int>{0, 1, 2, 5}));  // hand_end2, hand_end go
+  EXPECT_EQ(c.skeleton.names, (std::vector<std::string>{"root", "arm", "hand", "head"}));
+  EXPECT_EQ(c.skeleton.parents, (std::vector<int>{-1, 0, 1, 0}));
+  EXPECT_TRUE(c.skeleton.positions.row(3).isApprox(Eigen::RowVector3d(0, 1, 0)));
+  EXPECT_EQ(c.skeleton.leaf_tips.rows(), 4);
+  ASSERT_EQ(c.weights.cols(), 4);
+  EXPECT_EQ(c.weights.coeff(1, 2), 1.0);  // hand keeps its column, re-indexed
+  EXPECT_EQ(c.weights.coeff(2, 3), 1.0);  // head moved from column 5 to 3
+  c.validate();
+  EXPECT_EQ(drop_weightless_leaves(c).size(), 4u);  // every leaf now carries weight
+}
+
+TEST(DropWeightlessLeaves, WeightlessLeafBesideWeightedOnesGoesTooButNeverTheRoot) {
+  Character c = rig(false);  // head has no weight: it goes as well
+  EXPECT_EQ(drop_weightless_leaves(c), (std::vector<int>{0, 1, 2}));
+  EXPECT_EQ(c.skeleton.names, (std::vector<std::string>{"root", "arm", "hand"}));
+  Character single;
+  single.mesh = c.mesh;
+  single.skeleton = Skeleton::from_parent_names({"root"}, Eigen::MatrixXd::Zero(1, 3), {""}, "s");
+  single.weights.resize(3, 1);
+  EXPECT_EQ(drop_weightless_leaves(single), std::vector<int>{0});
+}
+
+}  // namespace SKINLAB_UNITY_ID
+}  // namespace
+}  // namespace skinlab::geometry
