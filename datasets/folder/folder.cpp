@@ -88,6 +88,7 @@ Folder::Options Folder::Options::from(const config::Node& node) {
   for (auto& p : o.include) p = strip_slashes(p);
   f.finish();
   o.where = node.where();
+  o.config_file = node.origin().file;
   return o;
 }
 
@@ -200,7 +201,9 @@ std::string relative_message(std::string message, const std::string& root) {
 fs::path Folder::root() const {
   const auto& o = options_;
   if (o.repository.empty()) return fs::path(o.path);
-  const std::string fetch = "; fetch it with `scripts/fetch_data <this dataset config>`";
+  const std::string fetch =
+      "; fetch it with `scripts/fetch_data " +
+      (o.config_file.empty() ? std::string("<dataset config>") : o.config_file) + "`";
   const char* data_dir = std::getenv("SKINLAB_DATA_DIR");
   const std::string repo = "repository " + o.repository + " at commit " + o.commit;
   if (data_dir == nullptr || *data_dir == '\0') {

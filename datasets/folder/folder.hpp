@@ -71,8 +71,9 @@ class Folder final : public DatasetBuilder {
     std::vector<std::string> include;  ///< glob patterns relative to `path`; empty: every file
     /// (pattern, reason) pairs in config order: matching files become Excluded with the reason.
     std::vector<std::pair<std::string, std::string>> exclude;
-    /// "file:line: key: " of the config node, for errors raised when reading (not a YAML key).
-    std::string where;
+    /// "file:line: key: " of the config node and its file, for errors raised when reading (not
+    /// YAML keys).
+    std::string where, config_file;
     static Options from(const config::Node& node);
   };
 
