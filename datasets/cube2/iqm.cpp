@@ -53,7 +53,7 @@ Eigen::Isometry3d local_transform(const ByteReader& r, std::size_t offset, const
 
 }  // namespace
 
-IqmFile read_iqm(std::string_view bytes, const std::string& source) {
+IqmFile read_iqm(std::string_view bytes, const std::string& source, bool read_clips) {
   const ByteReader r(bytes, source, ByteReader::Endian::kLittle);
   if (r.bytes(0, 16, "header magic") != std::string_view(kMagic, 16)) {
     r.fail(0, "header magic", "not an IQM file (expected \"INTERQUAKEMODEL\")");
@@ -193,6 +193,8 @@ IqmFile read_iqm(std::string_view bytes, const std::string& source) {
     model.W.setFromTriplets(triplets.begin(), triplets.end());  // duplicates are summed
   }
 
+  if (!read_clips) return out;
+
   // Poses, frames, animations.
   struct Pose {
     std::uint32_t mask;
@@ -263,9 +265,9 @@ IqmFile read_iqm(std::string_view bytes, const std::string& source) {
   return out;
 }
 
-IqmFile read_iqm_file(const std::filesystem::path& file) {
+IqmFile read_iqm_file(const std::filesystem::path& file, bool read_clips) {
   const std::string bytes = read_binary_file(file);
-  return read_iqm(bytes, file.string());
+  return read_iqm(bytes, file.string(), read_clips);
 }
 
 std::vector<Transforms> global_frames(const IqmClip& clip, const std::vector<int>& parents,

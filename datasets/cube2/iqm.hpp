@@ -57,9 +57,11 @@ struct IqmFile {
 /// Parses `bytes`. Throws IoError "<source>: <element> (byte offset N): <problem>" for a wrong
 /// magic or version, a truncated file, an offset or index out of range (naming the mesh, vertex,
 /// triangle, joint, pose or animation), an unsupported vertex-array format or a scaled joint.
-IqmFile read_iqm(std::string_view bytes, const std::string& source);
+/// Without `read_clips` poses, frames and animations are not read (pose_parents and clips stay
+/// empty), so a model whose clips scale joints (raylib's guy.iqm) still gives its bind pose.
+IqmFile read_iqm(std::string_view bytes, const std::string& source, bool read_clips = true);
 /// Reads and parses a file; errors name the file path.
-IqmFile read_iqm_file(const std::filesystem::path& file);
+IqmFile read_iqm_file(const std::filesystem::path& file, bool read_clips = true);
 
 /// Global transforms of every pose of every frame of `clip`, composed with `parents`.
 std::vector<Transforms> global_frames(const IqmClip& clip, const std::vector<int>& parents,

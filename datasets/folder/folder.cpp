@@ -1,10 +1,17 @@
 #include "datasets/folder/folder.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cctype>
+#include <cstdlib>
+#include <fstream>
+#include <limits>
 #include <set>
 
+#include "datasets/cube2/iqm.hpp"
+#include "datasets/rigged_model.hpp"
 #include "framework/core/error.hpp"
 #include "framework/core/registry.hpp"
 #include "framework/geometry/import_character.hpp"
@@ -14,17 +21,116 @@ namespace skinlab::datasets {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+bool is_repository(const std::string& s) {
+  const auto slash = s.find('/');
+  if (slash == std::string::npos || slash == 0 || slash + 1 == s.size() ||
+      s.find('/', slash + 1) != std::string::npos) {
+    return false;
+  }
+  return std::all_of(s.begin(), s.end(), [](unsigned char c) {
+    return std::isalnum(c) || c == '-' || c == '_' || c == '.' || c == '/';
+  }) && s[0] != '.' && s[slash + 1] != '.';
+}
+
+bool is_commit(const std::string& s) {
+  return s.size() == 40 && std::all_of(s.begin(), s.end(), [](unsigned char c) {
+           return std::isdigit(c) || (c >= 'a' && c <= 'f');
+         });
+}
+
+std::string strip_slashes(std::string p) {
+  while (!p.empty() && p.front() == '/') p.erase(p.begin());
+  return p;
+}
+
+}  // namespace
+
 Folder::Options Folder::Options::from(const config::Node& node) {
   Options o;
   config::Fields f(node, "dataset 'folder'");
-  f.required("path", o.path);
+  f.optional("repository", o.repository);
+  f.optional("commit", o.commit);
+  if (o.repository.empty()) {
+    f.required("path", o.path);
+    f.check(!o.path.empty(), "path", "must not be empty");
+  } else {
+    f.optional("path", o.path);
+  }
   f.optional("licence", o.licence);
   f.optional("attribution", o.attribution);
   f.optional("skeleton", o.skeleton);
+  f.optional("prefix", o.prefix);
   f.optional("recursive", o.recursive);
-  f.check(!o.path.empty(), "path", "must not be empty");
+  f.optional("include", o.include);
+  const config::Node exclude = f.section("exclude");
+  if (exclude.exists() && !exclude.is_null()) {
+    if (!exclude.is_map()) exclude.fail("expected a map of relative path or glob → reason");
+    for (const auto& pattern : exclude.keys()) {
+      o.exclude.emplace_back(strip_slashes(pattern), exclude[pattern].as<std::string>());
+      if (o.exclude.back().second.empty()) exclude[pattern].fail("the reason must not be empty");
+    }
+  }
+  f.check(o.repository.empty() || is_repository(o.repository), "repository",
+          "expected owner/name of a GitHub repository, got '" + o.repository + "'");
+  f.check(o.repository.empty() || !o.commit.empty(), "commit",
+          "is required with 'repository' (40 hex digits), so the data is reproducible");
+  f.check(o.commit.empty() || !o.repository.empty(), "commit",
+          "is only meaningful with 'repository: owner/name'");
+  f.check(o.commit.empty() || is_commit(o.commit), "commit",
+          "expected a full commit id of 40 lowercase hex digits, got '" + o.commit + "'");
+  f.check(o.repository.empty() ||
+              (!fs::path(o.path).is_absolute() &&
+               fs::path(o.path).lexically_normal().generic_string().rfind("..", 0) != 0),
+          "path", "must be a directory inside the repository (relative, without '..')");
+  for (const auto& p : o.include) f.check(!p.empty(), "include", "a pattern must not be empty");
+  for (auto& p : o.include) p = strip_slashes(p);
   f.finish();
+  o.where = node.where();
+  o.config_file = node.origin().file;
   return o;
+}
+
+bool glob_match(const std::string& pattern, const std::string& path) {
+  // Recursive matcher over C strings; patterns are short, so backtracking is cheap.
+  struct M {
+    static bool match(const char* p, const char* s) {
+      while (*p != '\0') {
+        if (p[0] == '*' && p[1] == '*') {
+          p += 2;
+          if (*p == '/') {  // "**/": zero or more whole directories
+            ++p;
+            if (match(p, s)) return true;
+            for (const char* t = s; *t != '\0'; ++t) {
+              if (*t == '/' && match(p, t + 1)) return true;
+            }
+            return false;
+          }
+          for (const char* t = s;; ++t) {  // "**": any run, '/' included
+            if (match(p, t)) return true;
+            if (*t == '\0') return false;
+          }
+        }
+        if (*p == '*') {
+          ++p;
+          for (const char* t = s;; ++t) {
+            if (match(p, t)) return true;
+            if (*t == '\0' || *t == '/') return false;
+          }
+        }
+        if (*p == '?') {
+          if (*s == '\0' || *s == '/') return false;
+        } else if (*p != *s) {
+          return false;
+        }
+        ++p;
+        ++s;
+      }
+      return *s == '\0';
+    }
+  };
+  return M::match(pattern.c_str(), path.c_str());
 }
 
 namespace {
@@ -53,68 +159,209 @@ void rotate_to_y_up(geometry::Character& c, const Eigen::Vector3d& up) {
   c.skeleton.positions = c.skeleton.positions * R.transpose();
 }
 
+/// Divides every weight row by its sum; returns how many rows were off 1 by more than 1e-3
+/// (the tolerance of geometry::WeightCheck) and the largest such deviation.
+std::pair<int, double> renormalise(geometry::SparseWeights& W) {
+  int off = 0;
+  double worst = 0;
+  for (Eigen::Index v = 0; v < W.outerSize(); ++v) {
+    double sum = 0;
+    for (geometry::SparseWeights::InnerIterator it(W, v); it; ++it) sum += it.value();
+    if (sum <= 0) continue;  // rejected by validation before this
+    if (std::abs(sum - 1) > 1e-3) {
+      ++off;
+      worst = std::max(worst, std::abs(sum - 1));
+    }
+    for (geometry::SparseWeights::InnerIterator it(W, v); it; ++it) it.valueRef() /= sum;
+  }
+  return {off, worst};
+}
+
+/// The commit a Git checkout is at, when `dir/.git/HEAD` holds a detached commit id (what
+/// scripts/fetch_data leaves); empty otherwise.
+std::string checked_out_commit(const fs::path& dir) {
+  std::ifstream in(dir / ".git" / "HEAD");
+  std::string head;
+  if (!(in >> head) || !is_commit(head)) return "";
+  return head;
+}
+
+/// `message` with every occurrence of `root/` removed, so that reasons name files relative to
+/// the scanned directory (the same on every machine).
+std::string relative_message(std::string message, const std::string& root) {
+  const std::string prefix = root + "/";
+  for (auto at = message.find(prefix); at != std::string::npos; at = message.find(prefix, at)) {
+    message.erase(at, prefix.size());
+  }
+  return message;
+}
+
 }  // namespace
 
-std::vector<SourceCharacter> Folder::read(std::vector<Excluded>& excluded) const {
-  const fs::path root(options_.path);
-  std::error_code ec;
-  if (!fs::is_directory(root, ec)) {
-    throw IoError(options_.path + ": dataset 'folder': not a readable directory");
+fs::path Folder::root() const {
+  const auto& o = options_;
+  if (o.repository.empty()) return fs::path(o.path);
+  const std::string fetch =
+      "; fetch it with `scripts/fetch_data " +
+      (o.config_file.empty() ? std::string("<dataset config>") : o.config_file) + "`";
+  const char* data_dir = std::getenv("SKINLAB_DATA_DIR");
+  const std::string repo = "repository " + o.repository + " at commit " + o.commit;
+  if (data_dir == nullptr || *data_dir == '\0') {
+    throw IoError(o.where + "dataset 'folder': " + repo +
+                  ": the environment variable SKINLAB_DATA_DIR is not set; it names the data "
+                  "folder that holds <owner>/<name>/ (expected " + o.repository +
+                  "/ under it)" + fetch + " and export SKINLAB_DATA_DIR");
   }
+  const fs::path checkout = fs::path(data_dir) / o.repository;
+  std::error_code ec;
+  if (!fs::is_directory(checkout, ec)) {
+    throw IoError(o.where + "dataset 'folder': " + repo + " is not in the data folder: expected " +
+                  checkout.string() + " (SKINLAB_DATA_DIR=" + data_dir + ")" + fetch);
+  }
+  const std::string head = checked_out_commit(checkout);
+  if (!head.empty() && head != o.commit) {
+    throw IoError(o.where + "dataset 'folder': " + checkout.string() + " is checked out at " +
+                  head + ", but the config names commit " + o.commit + fetch);
+  }
+  return o.path.empty() ? checkout : checkout / o.path;
+}
+
+std::vector<SourceCharacter> Folder::read(std::vector<Excluded>& excluded) const {
+  fs::path dir = root().lexically_normal();
+  if (!dir.has_filename() && dir.has_parent_path()) dir = dir.parent_path();  // no trailing '/'
+  const std::string label = options_.repository.empty() ? "folder" : options_.repository;
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) {
+    throw IoError(dir.string() + ": dataset 'folder'" +
+                  (options_.repository.empty() ? std::string()
+                                               : " (repository " + options_.repository + ")") +
+                  ": not a readable directory");
+  }
+  const bool recursive = options_.recursive || !options_.include.empty();
   std::vector<fs::path> files;
   try {
-    if (options_.recursive) {
-      for (const auto& e : fs::recursive_directory_iterator(root)) {
+    if (recursive) {
+      for (const auto& e : fs::recursive_directory_iterator(dir)) {
         if (e.is_regular_file()) files.push_back(e.path());
       }
     } else {
-      for (const auto& e : fs::directory_iterator(root)) {
+      for (const auto& e : fs::directory_iterator(dir)) {
         if (e.is_regular_file()) files.push_back(e.path());
       }
     }
   } catch (const fs::filesystem_error& e) {
-    throw IoError(options_.path + ": dataset 'folder': cannot list directory: " + e.what());
+    throw IoError(dir.string() + ": dataset 'folder': cannot list directory: " + e.what());
   }
   std::sort(files.begin(), files.end());
 
+  std::vector<bool> include_used(options_.include.size(), false);
+  std::vector<bool> exclude_used(options_.exclude.size(), false);
   std::vector<SourceCharacter> out;
   std::set<std::string> names;
+  int renormalised_files = 0;
+  long renormalised_vertices = 0;
+  const std::string root_text = dir.string();
   for (const auto& file : files) {
     const std::string ext = lower(file.extension().string());
     const bool obj = ext == ".obj";
-    if (!obj && !is_assimp_character(ext)) continue;
-    const std::string relative = fs::relative(file, root).generic_string();
+    const bool iqm = ext == ".iqm";
+    if (!obj && !iqm && !is_assimp_character(ext)) continue;
+    const std::string relative = fs::relative(file, dir).generic_string();
+    if (relative.rfind(".git/", 0) == 0) continue;
+    if (!options_.include.empty()) {
+      bool included = false;
+      for (std::size_t i = 0; i < options_.include.size(); ++i) {
+        if (glob_match(options_.include[i], relative)) included = include_used[i] = true;
+      }
+      if (!included) continue;
+    }
+    const std::string* reason = nullptr;
+    for (std::size_t i = 0; i < options_.exclude.size(); ++i) {
+      if (glob_match(options_.exclude[i].first, relative)) {
+        exclude_used[i] = true;
+        if (reason == nullptr) reason = &options_.exclude[i].second;
+      }
+    }
+    if (reason != nullptr) {
+      excluded.push_back({label, relative, *reason});
+      continue;
+    }
     try {
       geometry::Character c;
+      SourceCharacter s;
+      // Rows are renormalised below, where they are counted.
+      const geometry::WeightCheck keep_sums{std::numeric_limits<double>::infinity(), false};
       if (obj) {
         const fs::path rig = file.parent_path() / (file.stem().string() + "_rig.txt");
         if (!fs::exists(rig)) {
           throw IoError(relative + ": OBJ mesh without its RigNet rig file " +
                         rig.filename().string());
         }
-        c = geometry::read_obj_rig(file, rig);
+        c = geometry::read_obj_rig(file, rig, keep_sums);
+      } else if (iqm) {
+        cube2::IqmFile model = cube2::read_iqm_file(file, /*read_clips=*/false);
+        if (!model.has_geometry()) throw geometry::GeometryError(relative + ": no geometry (an animation file)");
+        if (model.model.joint_names.empty()) throw geometry::GeometryError(relative + ": no joints (a rigid prop)");
+        if (!model.has_blend_weights) throw geometry::GeometryError(relative + ": no blend indexes/weights");
+        model.model.name = relative;
+        c = to_source_rig(model.model).character;
+        s.up = Eigen::Vector3d::UnitZ();  // the Quake lineage's up axis (cube2.hpp)
       } else {
+        geometry::ImportOptions import;
+        import.weights = keep_sums;
         geometry::ImportReport report;
-        c = geometry::import_character(file, {}, &report);
+        c = geometry::import_character(file, import, &report);
         if (report.source_up) rotate_to_y_up(c, *report.source_up);
+      }
+      if (c.has_weights()) {
+        const auto [off, worst] = renormalise(c.weights);
+        if (off > 0) {
+          spdlog::warn("{}: {}: the weights of {} of {} vertices did not sum to 1 (by up to {:.3g}); "
+                       "renormalised", label, relative, off, c.mesh.num_vertices(), worst);
+          ++renormalised_files;
+          renormalised_vertices += off;
+        }
       }
       std::string name = fs::path(relative).replace_extension().generic_string();
       std::replace(name.begin(), name.end(), '/', '.');
+      name = options_.prefix + name;
       if (!names.insert(name).second) {
         throw IoError(relative + ": another file already gave a character named '" + name + "'");
       }
       c.name = name;
-      SourceCharacter s;
       s.character = std::move(c);
-      s.source = "folder";
+      s.source = label;
       s.path = relative;
       s.licence = options_.licence;
       s.attribution = options_.attribution;
-      s.skeleton = options_.skeleton.empty() ? file.stem().string() : options_.skeleton;
+      if (options_.skeleton.empty() || options_.skeleton == "stem") {
+        s.skeleton = file.stem().string();
+      } else if (options_.skeleton == "directory") {
+        s.skeleton = file.parent_path().filename().string();
+      } else {
+        s.skeleton = options_.skeleton;
+      }
       out.push_back(std::move(s));
     } catch (const std::exception& e) {
-      excluded.push_back({"folder", relative, e.what()});
+      excluded.push_back({label, relative, relative_message(e.what(), root_text)});
     }
+  }
+  for (std::size_t i = 0; i < options_.include.size(); ++i) {
+    if (!include_used[i]) {
+      throw ConfigError(options_.where + "dataset 'folder': include pattern '" +
+                        options_.include[i] + "' matches no character file under " + root_text);
+    }
+  }
+  for (std::size_t i = 0; i < options_.exclude.size(); ++i) {
+    if (!exclude_used[i]) {
+      throw ConfigError(options_.where + "dataset 'folder': exclude pattern '" +
+                        options_.exclude[i].first + "' matches no character file under " +
+                        root_text + " (a typo would keep what it means to exclude)");
+    }
+  }
+  if (renormalised_files > 0) {
+    spdlog::info("{}: renormalised the weights of {} vertices in {} files", label,
+                 renormalised_vertices, renormalised_files);
   }
   return out;
 }

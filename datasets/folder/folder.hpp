@@ -1,21 +1,51 @@
 #pragma once
 /// \file
 /// `folder`: every rigged character file under a directory, so a user can bring their own
-/// characters (RigNet's released data, Mixamo exports, studio assets).
+/// characters (RigNet's released data, studio assets) and a config can name a public Git
+/// repository of game assets at a fixed commit.
 ///
 /// Files: whatever the Open Asset Importer reads with bones (extensions .fbx .gltf .glb .dae
-/// .b3d .smd .x .md5mesh, case-insensitive; geometry::import_character), and `name.obj` with
-/// `name_rig.txt` beside it (RigNet's mesh + rig text; geometry::read_obj_rig). Other files are
-/// ignored; an `.obj` without its rig file, or any file that cannot be read or fails validation,
-/// becomes an Excluded entry with the error message. Files are visited in sorted path order so
-/// the character order does not depend on the file system.
+/// .b3d .smd .x .md5mesh, case-insensitive; geometry::import_character), Inter-Quake Models
+/// (.iqm, datasets/cube2/iqm.hpp; +Z up like every IQM), and `name.obj` with `name_rig.txt`
+/// beside it (RigNet's mesh + rig text; geometry::read_obj_rig). Other files are ignored; an
+/// `.obj` without its rig file, or any file that cannot be read or fails validation (a static
+/// prop without bones among them), becomes an Excluded entry with the error message. Files are
+/// visited in sorted path order so the character order does not depend on the file system.
 ///
-/// A character's name is its path relative to `path` without the extension, with '/' replaced
-/// by '.' (an HDF5 group name). FBX files that declare another up axis (ImportReport::source_up)
-/// are rotated to Y up here, since SourceCharacter carries no up axis; the normalisation of
-/// preprocessing then only scales and translates.
+/// Where the files are. Without `repository`, `path` is a directory (absolute, or relative to
+/// the working directory). With `repository: owner/name` and `commit: <40 hex digits>`, the
+/// files are those of that GitHub repository at that commit, which `scripts/fetch_data <config>`
+/// checks out into `${SKINLAB_DATA_DIR}/<owner>/<name>/`; `path` is then a directory inside the
+/// repository (default: its root). A missing SKINLAB_DATA_DIR or repository folder is an IoError
+/// naming the variable, the repository and the folder and telling to run scripts/fetch_data;
+/// when the folder is a Git checkout at another commit, that is an IoError too.
+///
+/// Which files. `include:` glob patterns select files by their path relative to `path`
+/// (then sub-directories are scanned whatever `recursive` says); `exclude:` maps a relative
+/// path or glob pattern to a reason, and every candidate file it matches becomes an Excluded
+/// entry with that reason without being read (rigged props, duplicates, other licences), so
+/// nothing is dropped silently. A pattern that matches no candidate file is a ConfigError (a
+/// typo would otherwise keep a prop). Globs: `*` is any run of characters other than '/', `?`
+/// one such character, `**` any run including '/' (`**/` also matches no directory), anchored
+/// at `path` (as `/`-anchored .gitignore patterns, which scripts/fetch_data makes of them for
+/// its sparse checkout); everything else is literal.
+///
+/// A character's name is `prefix` followed by its path relative to `path` without the
+/// extension, '/' replaced by '.' (an HDF5 group name). Its skeleton family is `skeleton`:
+/// `stem` (the default: each file its own family), `directory` (the name of the file's parent
+/// directory, e.g. the asset pack), or any other string as the family of every character. The
+/// dataset card lists the characters under the source `folder`, or under `owner/name` when a
+/// repository is given.
+///
+/// Weights. Rows that do not sum to 1 (within 1e-3) are divided by their sum; each file with
+/// such rows is logged with their count and the builder logs the total (import_character and
+/// read_obj_rig would renormalise silently or reject the file). FBX files that declare another
+/// up axis (ImportReport::source_up) are rotated to Y up here, since SourceCharacter carries no
+/// up axis for assimp files; the normalisation of preprocessing then only scales and translates.
 
+#include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "framework/data/source.hpp"
@@ -26,18 +56,36 @@ namespace skinlab::datasets {
 class Folder final : public DatasetBuilder {
  public:
   struct Options {
-    std::string path;         ///< directory to scan (required)
+    /// Directory to scan: required without `repository`; with it, a directory inside the
+    /// repository (relative, default: the repository's root).
+    std::string path;
+    std::string repository;   ///< "owner/name" of a GitHub repository, or empty
+    std::string commit;       ///< the repository's commit (40 hex digits; required with it)
     std::string licence;      ///< SPDX-style licence of every file, e.g. "CC-BY-SA-3.0"
     std::string attribution;  ///< authors, for the dataset card
-    /// Skeleton family of every character; empty: the file's stem (each file its own family).
+    /// Skeleton family: "stem" (or empty) for the file's stem, "directory" for its parent
+    /// directory's name, anything else for that fixed family.
     std::string skeleton;
+    std::string prefix;  ///< prepended to every character name, e.g. "kaykit."
     bool recursive = false;  ///< also scan sub-directories
+    std::vector<std::string> include;  ///< glob patterns relative to `path`; empty: every file
+    /// (pattern, reason) pairs in config order: matching files become Excluded with the reason.
+    std::vector<std::pair<std::string, std::string>> exclude;
+    /// "file:line: key: " of the config node and its file, for errors raised when reading (not
+    /// YAML keys).
+    std::string where, config_file;
     static Options from(const config::Node& node);
   };
 
   explicit Folder(Options options) : options_(std::move(options)) {}
 
-  /// Throws IoError if `path` is not a readable directory; per-file problems go to `excluded`.
+  /// The directory scanned: `path`, or `${SKINLAB_DATA_DIR}/<owner>/<name>/<path>` with a
+  /// repository. Throws IoError when SKINLAB_DATA_DIR is unset or the repository folder is
+  /// missing or checked out at another commit (see the file comment).
+  std::filesystem::path root() const;
+
+  /// Throws IoError if the directory is not readable (see root()), ConfigError for an include
+  /// or exclude pattern that matches no file; per-file problems go to `excluded`.
   std::vector<SourceCharacter> read(std::vector<Excluded>& excluded) const override;
 
   const Options& options() const { return options_; }
@@ -45,5 +93,8 @@ class Folder final : public DatasetBuilder {
  private:
   Options options_;
 };
+
+/// Whether `path` (relative, '/'-separated) matches the glob `pattern` of the file comment.
+bool glob_match(const std::string& pattern, const std::string& path);
 
 }  // namespace skinlab::datasets
