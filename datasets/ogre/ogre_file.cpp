@@ -125,8 +125,12 @@ class Cursor {
     c.length = u32(context + ": chunk " + hex(c.id) + " length");
     if (c.length < kChunkHeader || c.start + c.length > reader_.size()) {
       reader_.fail(c.start, context + ": chunk " + hex(c.id),
-                   "corrupt chunk length " + std::to_string(c.length) + " (the file has " +
-                       std::to_string(reader_.size()) + " bytes)");
+                   "corrupt chunk length " + std::to_string(c.length) +
+                       (c.length < kChunkHeader ? std::string(" (below the 6-byte header)")
+                                                : " (runs past the end: the file has " +
+                                                      std::to_string(reader_.size()) +
+                                                      " bytes; truncated, or miscounted by its "
+                                                      "exporter)"));
     }
     return c;
   }
