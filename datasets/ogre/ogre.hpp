@@ -42,10 +42,11 @@
 /// Licence and attribution: the first entry of `credits` whose glob matches the mesh's
 /// relative path or its file name, else `licence` / `attribution`.
 ///
-/// Animations (`animations: true`): the skeleton's first `max_animations_per_character` clips,
-/// sampled at `fps` from 0 to the clip length with OGRE's default interpolation
-/// (ogre::sample_animation). A clip that changes the derived scale of a kept joint relative to
-/// the bind pose cannot be written as rigid transforms and is left out (logged).
+/// Animations (`animations: true`): the skeleton's clips in file order, sampled at `fps` from 0
+/// to the clip length with OGRE's default interpolation (ogre::sample_animation), up to
+/// `max_animations_per_character`. A clip that changes the derived scale of a kept joint
+/// relative to the bind pose cannot be written as rigid transforms and is left out (logged;
+/// the next clip takes its place).
 
 #include <string>
 #include <vector>
