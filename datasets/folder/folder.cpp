@@ -23,23 +23,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-bool is_repository(const std::string& s) {
-  const auto slash = s.find('/');
-  if (slash == std::string::npos || slash == 0 || slash + 1 == s.size() ||
-      s.find('/', slash + 1) != std::string::npos) {
-    return false;
-  }
-  return std::all_of(s.begin(), s.end(), [](unsigned char c) {
-    return std::isalnum(c) || c == '-' || c == '_' || c == '.' || c == '/';
-  }) && s[0] != '.' && s[slash + 1] != '.';
-}
-
-bool is_commit(const std::string& s) {
-  return s.size() == 40 && std::all_of(s.begin(), s.end(), [](unsigned char c) {
-           return std::isdigit(c) || (c >= 'a' && c <= 'f');
-         });
-}
-
 std::string strip_slashes(std::string p) {
   while (!p.empty() && p.front() == '/') p.erase(p.begin());
   return p;
@@ -50,14 +33,7 @@ std::string strip_slashes(std::string p) {
 Folder::Options Folder::Options::from(const config::Node& node) {
   Options o;
   config::Fields f(node, "dataset 'folder'");
-  f.optional("repository", o.repository);
-  f.optional("commit", o.commit);
-  if (o.repository.empty()) {
-    f.required("path", o.path);
-    f.check(!o.path.empty(), "path", "must not be empty");
-  } else {
-    f.optional("path", o.path);
-  }
+  o.source = RepositorySource::from(f, node);
   f.optional("licence", o.licence);
   f.optional("attribution", o.attribution);
   f.optional("skeleton", o.skeleton);
@@ -72,23 +48,9 @@ Folder::Options Folder::Options::from(const config::Node& node) {
       if (o.exclude.back().second.empty()) exclude[pattern].fail("the reason must not be empty");
     }
   }
-  f.check(o.repository.empty() || is_repository(o.repository), "repository",
-          "expected owner/name of a GitHub repository, got '" + o.repository + "'");
-  f.check(o.repository.empty() || !o.commit.empty(), "commit",
-          "is required with 'repository' (40 hex digits), so the data is reproducible");
-  f.check(o.commit.empty() || !o.repository.empty(), "commit",
-          "is only meaningful with 'repository: owner/name'");
-  f.check(o.commit.empty() || is_commit(o.commit), "commit",
-          "expected a full commit id of 40 lowercase hex digits, got '" + o.commit + "'");
-  f.check(o.repository.empty() ||
-              (!fs::path(o.path).is_absolute() &&
-               fs::path(o.path).lexically_normal().generic_string().rfind("..", 0) != 0),
-          "path", "must be a directory inside the repository (relative, without '..')");
   for (const auto& p : o.include) f.check(!p.empty(), "include", "a pattern must not be empty");
   for (auto& p : o.include) p = strip_slashes(p);
   f.finish();
-  o.where = node.where();
-  o.config_file = node.origin().file;
   return o;
 }
 
@@ -177,15 +139,6 @@ std::pair<int, double> renormalise(geometry::SparseWeights& W) {
   return {off, worst};
 }
 
-/// The commit a Git checkout is at, when `dir/.git/HEAD` holds a detached commit id (what
-/// scripts/fetch_data leaves); empty otherwise.
-std::string checked_out_commit(const fs::path& dir) {
-  std::ifstream in(dir / ".git" / "HEAD");
-  std::string head;
-  if (!(in >> head) || !is_commit(head)) return "";
-  return head;
-}
-
 /// `message` with every occurrence of `root/` removed, so that reasons name files relative to
 /// the scanned directory (the same on every machine).
 std::string relative_message(std::string message, const std::string& root) {
@@ -198,43 +151,17 @@ std::string relative_message(std::string message, const std::string& root) {
 
 }  // namespace
 
-fs::path Folder::root() const {
-  const auto& o = options_;
-  if (o.repository.empty()) return fs::path(o.path);
-  const std::string fetch =
-      "; fetch it with `scripts/fetch_data " +
-      (o.config_file.empty() ? std::string("<dataset config>") : o.config_file) + "`";
-  const char* data_dir = std::getenv("SKINLAB_DATA_DIR");
-  const std::string repo = "repository " + o.repository + " at commit " + o.commit;
-  if (data_dir == nullptr || *data_dir == '\0') {
-    throw IoError(o.where + "dataset 'folder': " + repo +
-                  ": the environment variable SKINLAB_DATA_DIR is not set; it names the data "
-                  "folder that holds <owner>/<name>/ (expected " + o.repository +
-                  "/ under it)" + fetch + " and export SKINLAB_DATA_DIR");
-  }
-  const fs::path checkout = fs::path(data_dir) / o.repository;
-  std::error_code ec;
-  if (!fs::is_directory(checkout, ec)) {
-    throw IoError(o.where + "dataset 'folder': " + repo + " is not in the data folder: expected " +
-                  checkout.string() + " (SKINLAB_DATA_DIR=" + data_dir + ")" + fetch);
-  }
-  const std::string head = checked_out_commit(checkout);
-  if (!head.empty() && head != o.commit) {
-    throw IoError(o.where + "dataset 'folder': " + checkout.string() + " is checked out at " +
-                  head + ", but the config names commit " + o.commit + fetch);
-  }
-  return o.path.empty() ? checkout : checkout / o.path;
-}
+fs::path Folder::root() const { return options_.source.root("folder"); }
 
 std::vector<SourceCharacter> Folder::read(std::vector<Excluded>& excluded) const {
   fs::path dir = root().lexically_normal();
   if (!dir.has_filename() && dir.has_parent_path()) dir = dir.parent_path();  // no trailing '/'
-  const std::string label = options_.repository.empty() ? "folder" : options_.repository;
+  const std::string label = options_.source.repository.empty() ? "folder" : options_.source.repository;
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) {
     throw IoError(dir.string() + ": dataset 'folder'" +
-                  (options_.repository.empty() ? std::string()
-                                               : " (repository " + options_.repository + ")") +
+                  (options_.source.repository.empty() ? std::string()
+                                               : " (repository " + options_.source.repository + ")") +
                   ": not a readable directory");
   }
   const bool recursive = options_.recursive || !options_.include.empty();
@@ -348,13 +275,13 @@ std::vector<SourceCharacter> Folder::read(std::vector<Excluded>& excluded) const
   }
   for (std::size_t i = 0; i < options_.include.size(); ++i) {
     if (!include_used[i]) {
-      throw ConfigError(options_.where + "dataset 'folder': include pattern '" +
+      throw ConfigError(options_.source.where + "dataset 'folder': include pattern '" +
                         options_.include[i] + "' matches no character file under " + root_text);
     }
   }
   for (std::size_t i = 0; i < options_.exclude.size(); ++i) {
     if (!exclude_used[i]) {
-      throw ConfigError(options_.where + "dataset 'folder': exclude pattern '" +
+      throw ConfigError(options_.source.where + "dataset 'folder': exclude pattern '" +
                         options_.exclude[i].first + "' matches no character file under " +
                         root_text + " (a typo would keep what it means to exclude)");
     }

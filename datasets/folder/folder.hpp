@@ -48,6 +48,7 @@
 #include <utility>
 #include <vector>
 
+#include "datasets/repository.hpp"
 #include "framework/data/source.hpp"
 #include "framework/core/config.hpp"
 
@@ -56,11 +57,9 @@ namespace skinlab::datasets {
 class Folder final : public DatasetBuilder {
  public:
   struct Options {
-    /// Directory to scan: required without `repository`; with it, a directory inside the
-    /// repository (relative, default: the repository's root).
-    std::string path;
-    std::string repository;   ///< "owner/name" of a GitHub repository, or empty
-    std::string commit;       ///< the repository's commit (40 hex digits; required with it)
+    /// Where the files are (`path`, or `repository` + `commit` + `path` inside it; a missing
+    /// `path` with a repository is its root). datasets/repository.hpp.
+    RepositorySource source;
     std::string licence;      ///< SPDX-style licence of every file, e.g. "CC-BY-SA-3.0"
     std::string attribution;  ///< authors, for the dataset card
     /// Skeleton family: "stem" (or empty) for the file's stem, "directory" for its parent
@@ -71,9 +70,6 @@ class Folder final : public DatasetBuilder {
     std::vector<std::string> include;  ///< glob patterns relative to `path`; empty: every file
     /// (pattern, reason) pairs in config order: matching files become Excluded with the reason.
     std::vector<std::pair<std::string, std::string>> exclude;
-    /// "file:line: key: " of the config node and its file, for errors raised when reading (not
-    /// YAML keys).
-    std::string where, config_file;
     static Options from(const config::Node& node);
   };
 

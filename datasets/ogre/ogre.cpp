@@ -23,9 +23,7 @@ namespace fs = std::filesystem;
 OgreBuilder::Options OgreBuilder::Options::from(const config::Node& node) {
   Options o;
   config::Fields f(node, "dataset 'ogre'");
-  f.optional("repository", o.repository);
-  f.optional("commit", o.commit);
-  f.required("path", o.path);
+  o.source = RepositorySource::from(f, node);
   f.optional("licence", o.licence);
   f.optional("attribution", o.attribution);
   f.optional("animations", o.animations);
@@ -52,9 +50,6 @@ OgreBuilder::Options OgreBuilder::Options::from(const config::Node& node) {
     if (!exclude.is_map()) exclude.fail("expected a map of path glob → reason");
     for (const auto& glob : exclude.keys()) o.exclude.emplace_back(glob, exclude[glob].as<std::string>());
   }
-  f.check(!o.path.empty() || !o.repository.empty(), "path", "must not be empty");
-  f.check(o.repository.empty() || std::count(o.repository.begin(), o.repository.end(), '/') == 1,
-          "repository", "must be 'owner/name'");
   f.check(o.max_animations_per_character >= 0, "max_animations_per_character", "must be ≥ 0");
   f.check(o.fps > 0, "fps", "must be positive");
   f.check(o.up.size() == 3 && (o.up[0] != 0 || o.up[1] != 0 || o.up[2] != 0), "up",
@@ -65,16 +60,7 @@ OgreBuilder::Options OgreBuilder::Options::from(const config::Node& node) {
   return o;
 }
 
-std::string OgreBuilder::root() const {
-  if (options_.repository.empty()) return options_.path;
-  const char* data_dir = std::getenv("SKINLAB_DATA_DIR");
-  if (data_dir == nullptr || *data_dir == '\0') {
-    throw ConfigError("dataset 'ogre': repository '" + options_.repository +
-                      "' needs the environment variable SKINLAB_DATA_DIR (the folder holding "
-                      "<owner>/<name>/ snapshots)");
-  }
-  return (fs::path(data_dir) / options_.repository / options_.path).lexically_normal().string();
-}
+fs::path OgreBuilder::root() const { return options_.source.root("ogre"); }
 
 namespace {
 
@@ -135,13 +121,14 @@ const std::string kOriginJoint = "ogre_origin";
 }  // namespace
 
 std::vector<SourceCharacter> OgreBuilder::read(std::vector<Excluded>& excluded) const {
-  const fs::path dir(root());
+  const fs::path dir = root();
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) {
     throw IoError(dir.string() + ": dataset 'ogre': not a readable directory" +
-                  (options_.repository.empty() ? std::string()
-                                               : " (fetch " + options_.repository + " at " +
-                                                     options_.commit + " into SKINLAB_DATA_DIR)"));
+                  (options_.source.repository.empty()
+                       ? std::string()
+                       : " (repository " + options_.source.repository + " at " +
+                             options_.source.commit + ")"));
   }
   std::vector<fs::path> meshes;
   std::map<std::string, std::vector<fs::path>> skeletons_by_name;  // lower-case file name

@@ -52,6 +52,7 @@
 #include <vector>
 
 #include "framework/core/config.hpp"
+#include "datasets/repository.hpp"
 #include "framework/data/source.hpp"
 
 namespace skinlab::datasets {
@@ -65,9 +66,9 @@ class OgreBuilder final : public DatasetBuilder {
     std::string attribution;  ///< authors (and where the credit comes from)
   };
   struct Options {
-    std::string repository;   ///< "owner/name": `path` is relative to its data folder
-    std::string commit;       ///< the snapshot's commit (recorded for provenance)
-    std::string path;         ///< directory of the .mesh/.skeleton files (required)
+    /// Directory of the .mesh/.skeleton files: `path`, or `repository` + `commit` + `path`
+    /// inside it (datasets/repository.hpp).
+    RepositorySource source;
     std::string licence;      ///< SPDX-style licence of files no credit matches
     std::string attribution;  ///< authors of files no credit matches
     std::vector<Credit> credits;
@@ -89,9 +90,9 @@ class OgreBuilder final : public DatasetBuilder {
 
   explicit OgreBuilder(Options options) : options_(std::move(options)) {}
 
-  /// The directory the files are read from (see the file comment). Throws ConfigError when
-  /// `repository` is set but SKINLAB_DATA_DIR is not.
-  std::string root() const;
+  /// The directory the files are read from (RepositorySource::root: IoError when a named
+  /// repository is not in SKINLAB_DATA_DIR at its commit).
+  std::filesystem::path root() const;
 
   /// Throws IoError if the directory cannot be read; per-file problems go to `excluded`.
   std::vector<SourceCharacter> read(std::vector<Excluded>& excluded) const override;

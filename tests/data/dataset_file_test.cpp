@@ -112,7 +112,9 @@ TEST(DatasetFile, VersionOneFilesReadWithZeroLengthHelperBones) {
   EXPECT_EQ(r.characters[1].leaf_tips.size(), 0);
   const auto rig = r.characters[1].rig();
   for (const auto& b : rig.bones()) {
-    if (b.helper) EXPECT_TRUE(rig.bone_end(b).isApprox(rig.positions.row(b.start).transpose()));
+    if (b.helper) {
+      EXPECT_TRUE(rig.bone_end(b).isApprox(rig.positions.row(b.start).transpose()));
+    }
   }
 }
 

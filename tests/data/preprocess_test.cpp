@@ -183,6 +183,52 @@ TEST(BoneWeights, BranchingJointGoesToNearestBone) {
   EXPECT_EQ(index.cols(), 4) << "K is capped at #B";
 }
 
+TEST(PreprocessLeaves, DroppedWeightlessEndJointsTakeTheirClipTransformsWithThem) {
+  // OpenDungeons' Knight (bundled, with clips) with an extra weightless end joint under its first
+  // leaf, in every clip too.
+  std::vector<datasets::Excluded> excluded;
+  const auto builder = dataset_registry().create(
+      config::Config::parse("type: ogre\nlicence: CC0-1.0\npath: " SKINLAB_SOURCE_DIR
+                            "/datasets/ogre/bundled/opendungeons\n")
+          .root());
+  const auto knights = builder->read(excluded);
+  ASSERT_EQ(knights.size(), 1u);
+  const datasets::SourceCharacter& plain = knights[0];
+  ASSERT_FALSE(plain.animations.empty());
+  datasets::SourceCharacter extra = plain;
+  auto& sk = extra.character.skeleton;
+  const auto kids = sk.children();
+  int leaf = 0;
+  while (!kids[static_cast<std::size_t>(leaf)].empty()) ++leaf;
+  sk.names.push_back("extra_end");
+  sk.parents.push_back(leaf);
+  sk.positions.conservativeResize(sk.num_joints(), 3);
+  sk.positions.row(sk.num_joints() - 1) = sk.positions.row(leaf);
+  extra.character.weights.conservativeResize(extra.character.weights.rows(), sk.num_joints());
+  for (auto& a : extra.animations) {
+    a.bind.push_back(a.bind[static_cast<std::size_t>(leaf)]);
+    for (auto& frame : a.frames) frame.push_back(frame[static_cast<std::size_t>(leaf)]);
+  }
+  data::PreprocessOptions drop;
+  drop.drop_weightless_leaves = 1.0;
+  drop.leaf_bones.kind = distances::LeafBoneOptions::Kind::kExtended;
+  const auto a = data::preprocess(extra, euclidean(), drop);
+  data::PreprocessOptions keep = drop;
+  keep.drop_weightless_leaves = 0.0;
+  const auto b = data::preprocess(plain, euclidean(), keep);
+  // The extra joint is gone again (and so is any weightless end joint the player has).
+  EXPECT_LE(a.num_joints(), b.num_joints());
+  EXPECT_EQ(std::count(a.joint_names.begin(), a.joint_names.end(), "extra_end"), 0);
+  ASSERT_EQ(a.animations.size(), b.animations.size());
+  for (std::size_t i = 0; i < a.animations.size(); ++i) {
+    EXPECT_EQ(a.animations[i].bind.size(), static_cast<std::size_t>(12 * a.num_joints()));
+  }
+  // Extended leaf bones: tips for every joint, some leaf reaching beyond its joint.
+  ASSERT_EQ(a.leaf_tips.rows(), a.num_joints());
+  EXPECT_GT((a.leaf_tips - a.joints).rowwise().norm().maxCoeff(), 0.01);
+  EXPECT_EQ(data::preprocess(plain, euclidean()).leaf_tips.size(), 0);  // the paper's default
+}
+
 TEST(PreprocessOptions, UnknownFieldIsAnError) {
   const auto config = config::Config::parse("preprocess: {top_kk: 3}");
   testing::expect_error<ConfigError>(

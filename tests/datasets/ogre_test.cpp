@@ -4,6 +4,7 @@
 // skeleton v1.10).
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -37,7 +38,7 @@ void write_file(const fs::path& file, const std::string& bytes) {
 
 OgreBuilder::Options options_for(const std::string& path) {
   OgreBuilder::Options o;
-  o.path = path;
+  o.source.path = path;
   o.licence = "CC0-1.0";
   return o;
 }
@@ -332,12 +333,12 @@ TEST(Ogre, CorruptedFilesNeverCrash) {
 
 TEST(Ogre, OptionsAndRepositoryFolder) {
   const config::Config cfg = config::Config::parse(
-      "type: ogre\nrepository: OpenDungeons/OpenDungeons\ncommit: abc\npath: models\n"
+      "type: ogre\nrepository: OpenDungeons/OpenDungeons\ncommit: c83d4496b361f522a094cc8218199b2da1d4264c\npath: models\n"
       "licence: CC0-1.0\nup: [0, 0, 1]\nexclude: {\"Boulder.mesh\": a trap}\n"
       "credits: [{files: \"Orc.*\", licence: CC-BY-SA-3.0, attribution: Skorpio}]\n");
   const OgreBuilder::Options o = OgreBuilder::Options::from(cfg.root());
-  EXPECT_EQ(o.repository, "OpenDungeons/OpenDungeons");
-  EXPECT_EQ(o.commit, "abc");
+  EXPECT_EQ(o.source.repository, "OpenDungeons/OpenDungeons");
+  EXPECT_EQ(o.source.commit, "c83d4496b361f522a094cc8218199b2da1d4264c");
   EXPECT_EQ(o.up, (std::vector<double>{0, 0, 1}));
   ASSERT_EQ(o.exclude.size(), 1u);
   EXPECT_EQ(o.exclude[0].second, "a trap");
@@ -345,10 +346,16 @@ TEST(Ogre, OptionsAndRepositoryFolder) {
   EXPECT_EQ(o.credits[0].attribution, "Skorpio");
   const char* saved = std::getenv("SKINLAB_DATA_DIR");
   const std::string restore = saved ? saved : "";
-  ::setenv("SKINLAB_DATA_DIR", "/data", 1);
-  EXPECT_EQ(OgreBuilder(o).root(), "/data/OpenDungeons/OpenDungeons/models");
+  const std::filesystem::path data =
+      std::filesystem::temp_directory_path() / ("skinlab-ogre-data-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(data / "OpenDungeons/OpenDungeons");
+  ::setenv("SKINLAB_DATA_DIR", data.c_str(), 1);
+  EXPECT_EQ(OgreBuilder(o).root(), data / "OpenDungeons/OpenDungeons/models");
+  std::filesystem::remove_all(data);
+  testing::expect_error<IoError>([&] { OgreBuilder(o).root(); },
+                                 {"dataset 'ogre'", "OpenDungeons/OpenDungeons", "fetch_data"});
   ::unsetenv("SKINLAB_DATA_DIR");
-  testing::expect_error<ConfigError>([&] { OgreBuilder(o).root(); }, {"SKINLAB_DATA_DIR"});
+  testing::expect_error<IoError>([&] { OgreBuilder(o).root(); }, {"SKINLAB_DATA_DIR"});
   if (saved) ::setenv("SKINLAB_DATA_DIR", restore.c_str(), 1);
   testing::expect_error<ConfigError>(
       [&] { OgreBuilder::Options::from(config::Config::parse("type: ogre\npath: x\nfoo: 1\n").root()); },
