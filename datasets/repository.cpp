@@ -43,6 +43,7 @@ std::string checked_out_commit(const fs::path& dir) {
 
 RepositorySource RepositorySource::from(config::Fields& f, const config::Node& node) {
   RepositorySource o;
+  f.optional("source", o.name);
   f.optional("repository", o.repository);
   f.optional("commit", o.commit);
   if (o.repository.empty()) {
@@ -66,6 +67,11 @@ RepositorySource RepositorySource::from(config::Fields& f, const config::Node& n
   o.where = node.where();
   o.config_file = node.origin().file;
   return o;
+}
+
+std::string RepositorySource::label(const std::string& builder) const {
+  if (!name.empty()) return name;
+  return repository.empty() ? builder : repository;
 }
 
 fs::path RepositorySource::root(const std::string& builder) const {

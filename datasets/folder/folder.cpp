@@ -156,7 +156,7 @@ fs::path Folder::root() const { return options_.source.root("folder"); }
 std::vector<SourceCharacter> Folder::read(std::vector<Excluded>& excluded) const {
   fs::path dir = root().lexically_normal();
   if (!dir.has_filename() && dir.has_parent_path()) dir = dir.parent_path();  // no trailing '/'
-  const std::string label = options_.source.repository.empty() ? "folder" : options_.source.repository;
+  const std::string label = options_.source.label("folder");
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) {
     throw IoError(dir.string() + ": dataset 'folder'" +

@@ -191,7 +191,7 @@ std::vector<SourceCharacter> OgreBuilder::read(std::vector<Excluded>& excluded) 
     const auto excluded_by = std::find_if(options_.exclude.begin(), options_.exclude.end(),
                                           [&](const auto& e) { return glob_matches(e.first, rel); });
     if (excluded_by != options_.exclude.end()) {
-      excluded.push_back({"ogre", rel, "excluded by the config (" + excluded_by->first + "): " + excluded_by->second});
+      excluded.push_back({options_.source.label("ogre"), rel, "excluded by the config (" + excluded_by->first + "): " + excluded_by->second});
       continue;
     }
     try {
@@ -342,7 +342,7 @@ std::vector<SourceCharacter> OgreBuilder::read(std::vector<Excluded>& excluded) 
       SourceRig rig = to_source_rig(model);
 
       SourceCharacter sc;
-      sc.source = "ogre";
+      sc.source = options_.source.label("ogre");
       sc.path = rel;
       sc.skeleton = skeleton_file.stem().string();
       sc.up = Eigen::Vector3d(options_.up[0], options_.up[1], options_.up[2]).normalized();
@@ -402,7 +402,7 @@ std::vector<SourceCharacter> OgreBuilder::read(std::vector<Excluded>& excluded) 
       sc.character = std::move(rig.character);
       out.push_back(std::move(sc));
     } catch (const std::exception& e) {  // Error, and e.g. bad_alloc on absurd counts
-      excluded.push_back({"ogre", rel, e.what()});
+      excluded.push_back({options_.source.label("ogre"), rel, e.what()});
     }
   }
   return out;

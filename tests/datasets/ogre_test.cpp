@@ -333,11 +333,12 @@ TEST(Ogre, CorruptedFilesNeverCrash) {
 
 TEST(Ogre, OptionsAndRepositoryFolder) {
   const config::Config cfg = config::Config::parse(
-      "type: ogre\nrepository: OpenDungeons/OpenDungeons\ncommit: c83d4496b361f522a094cc8218199b2da1d4264c\npath: models\n"
+      "type: ogre\nsource: opendungeons\nrepository: OpenDungeons/OpenDungeons\ncommit: c83d4496b361f522a094cc8218199b2da1d4264c\npath: models\n"
       "licence: CC0-1.0\nup: [0, 0, 1]\nexclude: {\"Boulder.mesh\": a trap}\n"
       "credits: [{files: \"Orc.*\", licence: CC-BY-SA-3.0, attribution: Skorpio}]\n");
   const OgreBuilder::Options o = OgreBuilder::Options::from(cfg.root());
   EXPECT_EQ(o.source.repository, "OpenDungeons/OpenDungeons");
+  EXPECT_EQ(o.source.label("ogre"), "opendungeons");  // the name splits and the card use
   EXPECT_EQ(o.source.commit, "c83d4496b361f522a094cc8218199b2da1d4264c");
   EXPECT_EQ(o.up, (std::vector<double>{0, 0, 1}));
   ASSERT_EQ(o.exclude.size(), 1u);
