@@ -56,8 +56,10 @@ std::map<std::string, data::Coverage> coverage_of(const data::Dataset& d,
   return out;
 }
 
-/// Prints the candidate coverage (data/coverage.hpp) of every distance over `which`.
+/// Prints the candidate coverage `coverage` (data/coverage.hpp, per distance) of the
+/// characters `which` of `d`.
 void print_coverage(const data::Dataset& d, const std::vector<int>& which,
+                    const std::map<std::string, data::Coverage>& coverage,
                     const std::string& label) {
   std::array<long, 6> histogram{};  // 0 .. 5+ influences per vertex
   for (int i : which) {
@@ -81,7 +83,7 @@ void print_coverage(const data::Dataset& d, const std::vector<int>& which,
       data::kInfluential, 100.0 * histogram[1] / vertices, 100.0 * histogram[2] / vertices,
       100.0 * histogram[3] / vertices, 100.0 * histogram[4] / vertices,
       100.0 * histogram[5] / vertices, 100.0 * histogram[0] / vertices);
-  for (const auto& [type, cov] : coverage_of(d, which)) {
+  for (const auto& [type, cov] : coverage) {
     std::string entry, weight;
     for (int k = 1; k <= cov.max_k; ++k) {
       entry += fmt::format(" {}: {:.2f}%", k, 100 * cov.entry_share(k));
@@ -102,19 +104,17 @@ void print_coverage(const data::Dataset& d, const std::vector<int>& which,
   }
 }
 
+/// Coverage per part ("all", then "test:<split>") and distance.
+using PartCoverage = std::vector<std::pair<std::string, std::map<std::string, data::Coverage>>>;
+
 /// Fig. 6 on the dataset: per distance, weight coverage (blue) and entry coverage (orange)
-/// against K over all characters, as `coverage_<distance>.png`, and every value in
+/// against K over all characters, as `coverage_<distance>.png`, and every value of `parts` in
 /// `coverage.csv` (distance, part, K, entry, weight), in `dir`.
-void write_coverage_figures(const data::Dataset& d, const std::filesystem::path& dir) {
+void write_coverage_figures(const PartCoverage& parts, const std::filesystem::path& dir) {
   std::filesystem::create_directories(dir);
-  std::vector<std::pair<std::string, std::vector<int>>> parts;
-  std::vector<int> all(d.characters.size());
-  std::iota(all.begin(), all.end(), 0);
-  parts.emplace_back("all", all);
-  for (const auto& [name, s] : d.splits) parts.emplace_back("test:" + name, s.test);
   std::string csv = "distance,part,k,entry_coverage,weight_coverage\n";
-  for (const auto& [part, which] : parts) {
-    for (const auto& [type, cov] : coverage_of(d, which)) {
+  for (const auto& [part, coverage] : parts) {
+    for (const auto& [type, cov] : coverage) {
       for (int k = 1; k <= cov.max_k; ++k) {
         csv += fmt::format("{},{},{},{:.6f},{:.6f}\n", type, part, k, cov.entry_share(k),
                            cov.weight_share(k));
@@ -162,10 +162,13 @@ int run_dataset_info(const std::string& file, const std::string& figures) {
   }
   std::vector<int> all(d.characters.size());
   std::iota(all.begin(), all.end(), 0);
-  print_coverage(d, all, "all characters");
-  for (const auto& [name, s] : d.splits)
-    print_coverage(d, s.test, "test part of split '" + name + "'");
-  if (!figures.empty()) write_coverage_figures(d, figures);
+  PartCoverage parts{{"all", coverage_of(d, all)}};
+  print_coverage(d, all, parts.back().second, "all characters");
+  for (const auto& [name, s] : d.splits) {
+    parts.emplace_back("test:" + name, coverage_of(d, s.test));
+    print_coverage(d, s.test, parts.back().second, "test part of split '" + name + "'");
+  }
+  if (!figures.empty()) write_coverage_figures(parts, figures);
   std::cout << fmt::format("excluded: {}\n", d.excluded.size());
   for (const auto& e : d.excluded) {
     std::cout << fmt::format("  {}:{}: {}\n", e.source, e.path, e.reason);

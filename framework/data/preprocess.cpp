@@ -148,8 +148,10 @@ PreparedCharacter preprocess(const datasets::SourceCharacter& source,
   const bool weighted = c.has_weights();
   if (!weighted && mode.require_weights) throw Error(where + ": character has no skin weights");
 
-  // 0. The other convention of skeleton ends, for a share of the characters.
-  std::vector<datasets::Animation> animations = source.animations;
+  // 0. The other convention of skeleton ends, for a share of the characters; only then are the
+  // clips copied, to follow the kept joints.
+  const std::vector<datasets::Animation>* clips = &source.animations;
+  std::vector<datasets::Animation> reindexed;
   if (weighted && drops_weightless_leaves(options, c.name)) {
     const std::vector<int> kept = geometry::drop_weightless_leaves(c);
     const auto keep = [&kept](const std::vector<Eigen::Isometry3d>& per_joint) {
@@ -162,11 +164,13 @@ PreparedCharacter preprocess(const datasets::SourceCharacter& source,
       return out;
     };
     const std::size_t before = source.character.skeleton.names.size();
-    for (auto& a : animations) {  // clips follow the kept joints; a clip of another size stays
-      if (a.bind.size() != before) continue;  // as it is (and is reported below)
+    reindexed = source.animations;
+    for (auto& a : reindexed) {  // a clip of another size stays as it is (reported below)
+      if (a.bind.size() != before) continue;
       a.bind = keep(a.bind);
       for (auto& frame : a.frames) frame = keep(frame);
     }
+    clips = &reindexed;
   }
 
   // 1. Normalise.
@@ -264,7 +268,7 @@ PreparedCharacter preprocess(const datasets::SourceCharacter& source,
   out.licence = source.licence;
   out.attribution = source.attribution;
   out.skeleton = source.skeleton;
-  for (const auto& a : animations) {
+  for (const auto& a : *clips) {
     out.animations.push_back(convert(a, sim.matrix(), c.skeleton.num_joints(), where));
   }
   return out;

@@ -1,9 +1,6 @@
 #include "framework/distances/leaf_bones.hpp"
 
-#include <CGAL/AABB_traits.h>
-#include <CGAL/AABB_tree.h>
-#include <CGAL/AABB_triangle_primitive.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include "framework/distances/triangle_tree.hpp"
 
 #include <cmath>
 #include <limits>
@@ -16,13 +13,10 @@ namespace {
 // Nested so that these names never meet another file's in a unity translation unit.
 namespace leaf_geometry {
 
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Point = Kernel::Point_3;
-using Ray = Kernel::Ray_3;
-using Triangle = Kernel::Triangle_3;
-using TriangleIterator = std::vector<Triangle>::const_iterator;
-using Primitive = CGAL::AABB_triangle_primitive<Kernel, TriangleIterator>;
-using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>>;
+using aabb::Kernel;
+using aabb::Point;
+using aabb::Ray;
+using aabb::Tree;
 
 Point point(const Eigen::Vector3d& p) { return {p.x(), p.y(), p.z()}; }
 Eigen::Vector3d vec(const Point& p) { return {p.x(), p.y(), p.z()}; }
@@ -40,16 +34,8 @@ LeafBoneOptions::Kind parse_kind(const config::Node& node) {
 /// The `extended` construction (leaf_bones.hpp) on a validated mesh and skeleton.
 Eigen::MatrixXd tips_by_rays(const geometry::Mesh& mesh, const geometry::Skeleton& skeleton,
                              double max_length, double coincident) {
-  std::vector<Triangle> triangles;
-  triangles.reserve(static_cast<std::size_t>(mesh.num_faces()));
-  for (int f = 0; f < mesh.num_faces(); ++f) {
-    const Triangle t(point(mesh.V.row(mesh.F(f, 0)).transpose()),
-                     point(mesh.V.row(mesh.F(f, 1)).transpose()),
-                     point(mesh.V.row(mesh.F(f, 2)).transpose()));
-    if (!t.is_degenerate()) triangles.push_back(t);  // a zero-area face stops no ray
-  }
-  Tree tree(triangles.cbegin(), triangles.cend());
-  tree.build();
+  const aabb::TriangleTree triangles(mesh);
+  const Tree& tree = triangles.tree();
 
   Eigen::MatrixXd tips = skeleton.positions;
   const auto children = skeleton.children();

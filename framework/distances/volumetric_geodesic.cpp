@@ -1,9 +1,7 @@
 #include "framework/distances/volumetric_geodesic.hpp"
 
-#include <CGAL/AABB_traits.h>
-#include <CGAL/AABB_tree.h>
-#include <CGAL/AABB_triangle_primitive.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include "framework/distances/triangle_tree.hpp"
+
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -24,13 +22,8 @@ namespace skinlab::distances {
 
 namespace {
 
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Point = Kernel::Point_3;
-using Segment = Kernel::Segment_3;
-using Triangle = Kernel::Triangle_3;
-using TriangleIterator = std::vector<Triangle>::const_iterator;
-using Primitive = CGAL::AABB_triangle_primitive<Kernel, TriangleIterator>;
-using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>>;
+using aabb::Point;
+using aabb::Segment;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 const char* const kOwner = "distance 'volumetric_geodesic'";
@@ -181,16 +174,8 @@ Eigen::MatrixXd VolumetricGeodesic::compute(const geometry::Mesh& mesh,
 
   // ---- stage 1: AABB tree over the non-degenerate triangles, surface graph ------------------
   auto start = std::chrono::steady_clock::now();
-  std::vector<Triangle> triangles;
-  triangles.reserve(mesh.num_faces());
-  const auto point = [&](int v) { return Point(mesh.V(v, 0), mesh.V(v, 1), mesh.V(v, 2)); };
-  for (int f = 0; f < mesh.num_faces(); ++f) {
-    Triangle tri(point(mesh.F(f, 0)), point(mesh.F(f, 1)), point(mesh.F(f, 2)));
-    // A zero-area face blocks no ray, and CGAL's segment–triangle test requires a proper one.
-    if (!tri.is_degenerate()) triangles.push_back(tri);
-  }
-  Tree tree(triangles.cbegin(), triangles.cend());
-  tree.build();  // explicitly, so that concurrent queries below never trigger a lazy build
+  const aabb::TriangleTree triangles(mesh);  // built now: concurrent queries below never build
+  const aabb::Tree& tree = triangles.tree();
   const SurfaceGraph graph = build_graph(mesh);
   t.aabb = seconds_since(start);
 
