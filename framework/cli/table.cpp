@@ -1,7 +1,8 @@
 /// \file
 /// `skinlab table <run_dir>... [--part test] [--format md|csv|tex] [--metrics a,b] [--title T]
-/// [--out file]`: the comparison table of saved, evaluated runs (framework/report/table.hpp);
-/// the first run is the reference of the ANOVA columns. Without --out it prints the table.
+/// [--out file] [--group-runs] [--across-splits]`: the comparison table of saved, evaluated runs
+/// (framework/report/table.hpp); the first run is the reference of the ANOVA columns. Without
+/// --out it prints the table.
 
 #include <filesystem>
 #include <iostream>
@@ -32,6 +33,10 @@ Command add_table(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--title", args->options.title, "caption");
   cmd->add_option("--out", args->out, "file to write (atomically); default: standard output");
+  cmd->add_flag("--group-runs", args->options.group_runs,
+                "runs of one experiment (seeds) form one row: mean ± sd across the runs");
+  cmd->add_flag("--across-splits", args->options.across_splits,
+                "generalisation table: methods x the test sets the runs were evaluated on");
   return {cmd, [args] {
             std::vector<report::RunResult> runs;
             for (const auto& dir : args->runs) runs.push_back(report::load_run_result(dir, args->part));

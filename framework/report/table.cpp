@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 #include "framework/core/atomic_file.hpp"
@@ -110,6 +112,91 @@ std::string render(const std::vector<std::vector<std::string>>& rows, const std:
   return out;
 }
 
+/// The first character where two runs' character lists differ, for the error message.
+std::string first_difference(const RunResult& run, const RunResult& ref) {
+  for (std::size_t i = 0; i < std::min(run.characters.size(), ref.characters.size()); ++i) {
+    if (run.characters[i] != ref.characters[i]) {
+      return "'" + run.characters[i] + "' where " + ref.dir.string() + " has '" +
+             ref.characters[i] + "'";
+    }
+  }
+  return "(count " + std::to_string(run.characters.size()) + " vs " +
+         std::to_string(ref.characters.size()) + ")";
+}
+
+void require_same_characters(const RunResult& run, const RunResult& ref) {
+  if (run.characters == ref.characters) return;
+  throw Error("table: " + run.dir.string() + " was evaluated on other characters than " +
+              ref.dir.string() + ": " + first_difference(run, ref) +
+              "; evaluate every run on the same dataset, split and part");
+}
+
+void require_metrics(const RunResult& run, const std::vector<std::string>& metrics) {
+  for (const auto& m : metrics) {
+    if (!run.values.count(m)) {
+      throw Error("table: " + run.dir.string() + " has no metric '" + m + "' in eval_" +
+                  run.part + ".json");
+    }
+  }
+}
+
+void require_format(const TableOptions& options) {
+  if (options.format != "md" && options.format != "csv" && options.format != "tex") {
+    throw Error("table: unknown format '" + options.format + "'; choose md, csv or tex");
+  }
+}
+
+/// One row of a table: a run, or (group_runs) every run of one experiment, all on the same
+/// characters.
+struct Row {
+  std::string label;
+  std::vector<const RunResult*> runs;
+
+  std::string run_ids() const {
+    std::string ids;
+    for (const auto* r : runs) ids += (ids.empty() ? "" : ", ") + r->run_id;
+    return ids;
+  }
+  /// Each character's mean over the runs (NaN where every run's value is NaN).
+  std::vector<double> character_means(const std::string& metric) const {
+    const std::size_t n = runs.front()->characters.size();
+    std::vector<double> out(n, std::nan(""));
+    for (std::size_t c = 0; c < n; ++c) {
+      std::vector<double> x;
+      for (const auto* r : runs) x.push_back(r->values.at(metric)[c]);
+      out[c] = stats_of(x).mean;
+    }
+    return out;
+  }
+  /// One run: mean ± sd over characters; several: mean ± sd across the runs of their means.
+  MeanSd shown(const std::string& metric) const {
+    if (runs.size() == 1) return stats_of(runs.front()->values.at(metric));
+    std::vector<double> means;
+    for (const auto* r : runs) means.push_back(stats_of(r->values.at(metric)).mean);
+    return stats_of(means);
+  }
+};
+
+/// The one-way ANOVA cell "F (p)" of two per-character value lists, or "n/a" when too few
+/// characters have the metric defined (a metric undefined for some is tested on the others).
+std::optional<eval::Anova> anova_of(const std::vector<double>& a, const std::vector<double>& b) {
+  const auto x = defined(a), y = defined(b);
+  if (x.empty() || y.empty() || x.size() + y.size() < 3) return std::nullopt;
+  return eval::one_way_anova({x, y});
+}
+
+/// The metric definitions quoted under a Markdown table (the first run's).
+std::string definitions_text(const RunResult& ref) {
+  if (!ref.metric_definitions.empty()) {
+    return "Metrics (the first run's evaluation): " + ref.metric_definitions + "\n";
+  }
+  if (!ref.metrics_yaml.empty() && ref.metrics_yaml != "[]") {
+    return "Metric definitions and thresholds (the first run's config):\n\n```yaml\n" +
+           ref.metrics_yaml + (ref.metrics_yaml.back() == '\n' ? "" : "\n") + "```\n";
+  }
+  return "";
+}
+
 }  // namespace
 
 RunResult load_run_result(const fs::path& dir, const std::string& part) {
@@ -157,43 +244,34 @@ RunResult load_run_result(const fs::path& dir, const std::string& part) {
 
 std::string make_table(const std::vector<RunResult>& runs, const TableOptions& options) {
   if (runs.empty()) throw Error("table: no runs given");
-  if (options.format != "md" && options.format != "csv" && options.format != "tex") {
-    throw Error("table: unknown format '" + options.format + "'; choose md, csv or tex");
-  }
+  if (options.across_splits) return make_split_table(runs, options);
+  require_format(options);
   const RunResult& ref = runs.front();
   for (const auto& run : runs) {
-    if (run.characters != ref.characters) {
-      std::string first = "(count " + std::to_string(run.characters.size()) + " vs " +
-                          std::to_string(ref.characters.size()) + ")";
-      for (std::size_t i = 0; i < std::min(run.characters.size(), ref.characters.size()); ++i) {
-        if (run.characters[i] != ref.characters[i]) {
-          first = "'" + run.characters[i] + "' where " + ref.dir.string() + " has '" +
-                  ref.characters[i] + "'";
-          break;
-        }
-      }
-      throw Error("table: " + run.dir.string() + " was evaluated on other characters than " +
-                  ref.dir.string() + ": " + first + "; evaluate every run on the same dataset, "
-                  "split and part");
-    }
-    for (const auto& m : options.metrics) {
-      if (!run.values.count(m)) {
-        throw Error("table: " + run.dir.string() + " has no metric '" + m + "' in eval_" +
-                    run.part + ".json");
-      }
+    require_same_characters(run, ref);
+    require_metrics(run, options.metrics);
+  }
+  std::vector<Row> rows;
+  for (const auto& run : runs) {
+    auto same = std::find_if(rows.begin(), rows.end(), [&](const Row& r) { return r.label == run.label; });
+    if (options.group_runs && same != rows.end()) {
+      same->runs.push_back(&run);
+    } else {
+      rows.push_back({run.label, {&run}});
     }
   }
+  const bool grouped = std::any_of(rows.begin(), rows.end(), [](const Row& r) { return r.runs.size() > 1; });
 
-  std::vector<std::vector<std::string>> main{{"Method", "Run"}};
+  std::vector<std::vector<std::string>> main{{"Method", grouped ? "Runs" : "Run"}};
   for (const auto& m : options.metrics) main.front().push_back(eval::value_display(m).column_header());
-  for (const auto& run : runs) {
-    std::vector<std::string> row{run.label, run.run_id};
+  for (const auto& row : rows) {
+    std::vector<std::string> cells{row.label, row.run_ids()};
     for (const auto& m : options.metrics) {
       const eval::ValueDisplay c = eval::value_display(m);
-      const MeanSd s = stats_of(run.values.at(m));
-      row.push_back(value_text(s.mean, c) + " ± " + value_text(s.sd, c));
+      const MeanSd s = row.shown(m);
+      cells.push_back(value_text(s.mean, c) + " ± " + value_text(s.sd, c));
     }
-    main.push_back(std::move(row));
+    main.push_back(std::move(cells));
   }
 
   std::string out;
@@ -202,28 +280,22 @@ std::string make_table(const std::vector<RunResult>& runs, const TableOptions& o
   if (options.format == "tex") out += "\\begin{table}\n\\centering\n";
   out += render(main, options.format, 2);
   // An ANOVA needs two characters per run (a CI smoke run on one test character has none).
-  if (runs.size() > 1 && ref.characters.size() > 1) {
-    // Runs of one experiment (e.g. seeds) are told apart by their run id.
-    auto name = [&](const RunResult& run) {
+  if (rows.size() > 1 && ref.characters.size() > 1) {
+    // Rows of one experiment (e.g. seeds not grouped) are told apart by their run ids.
+    auto name = [&](const Row& row) {
       int same = 0;
-      for (const auto& other : runs) same += other.label == run.label;
-      return same > 1 ? run.label + " (" + run.run_id + ")" : run.label;
+      for (const auto& other : rows) same += other.label == row.label;
+      return same > 1 ? row.label + " (" + row.run_ids() + ")" : row.label;
     };
-    std::vector<std::vector<std::string>> anova{{"One-way ANOVA vs " + name(ref)}};
+    std::vector<std::vector<std::string>> anova{{"One-way ANOVA vs " + name(rows.front())}};
     for (const auto& m : options.metrics) anova.front().push_back(eval::value_display(m).column_header() + " F (p)");
-    for (std::size_t r = 1; r < runs.size(); ++r) {
-      std::vector<std::string> row{name(runs[r])};
+    for (std::size_t r = 1; r < rows.size(); ++r) {
+      std::vector<std::string> cells{name(rows[r])};
       for (const auto& m : options.metrics) {
-        // A metric undefined for some characters (NaN) is tested on the others.
-        const auto x = defined(ref.values.at(m)), y = defined(runs[r].values.at(m));
-        if (x.empty() || y.empty() || x.size() + y.size() < 3) {
-          row.push_back("n/a");
-          continue;
-        }
-        const auto a = eval::one_way_anova({x, y});
-        row.push_back(fmt::format("{:.4f} ({})", a.F, p_text(a.p)));
+        const auto a = anova_of(rows.front().character_means(m), rows[r].character_means(m));
+        cells.push_back(a ? fmt::format("{:.4f} ({})", a->F, p_text(a->p)) : "n/a");
       }
-      anova.push_back(std::move(row));
+      anova.push_back(std::move(cells));
     }
     out += md ? "\n" : options.format == "csv" ? "\n" : "\\medskip\n";
     out += render(anova, options.format, 1);
@@ -236,13 +308,143 @@ std::string make_table(const std::vector<RunResult>& runs, const TableOptions& o
     out += fmt::format("\n{} characters of the {} part of split '{}' of `{}`; mean ± sample "
                        "standard deviation over characters", ref.characters.size(), ref.part,
                        ref.split, ref.dataset);
-    out += ".\n";
-    if (!ref.metric_definitions.empty()) {
-      out += "Metrics (the first run's evaluation): " + ref.metric_definitions + "\n";
-    } else if (!ref.metrics_yaml.empty() && ref.metrics_yaml != "[]") {
-      out += "Metric definitions and thresholds (the first run's config):\n\n```yaml\n" +
-             ref.metrics_yaml + (ref.metrics_yaml.back() == '\n' ? "" : "\n") + "```\n";
+    if (grouped) {
+      out += "; a row of several runs (seeds) gives the mean ± sample standard deviation across "
+             "the runs of their means, and its ANOVA uses each character's mean over the runs";
     }
+    out += ".\n";
+    out += definitions_text(ref);
+    if (!options.command.empty()) out += "Generated by `" + options.command + "`.\n";
+  }
+  return out;
+}
+
+std::string make_split_table(const std::vector<RunResult>& runs, const TableOptions& options) {
+  if (runs.empty()) throw Error("table: no runs given");
+  require_format(options);
+  for (const auto& run : runs) require_metrics(run, options.metrics);
+
+  // Columns: the test sets, by dataset and split, in order of appearance.
+  struct Column {
+    std::string dataset, split;
+    std::string name;
+  };
+  std::vector<Column> columns;
+  auto column_of = [&](const RunResult& run) {
+    for (std::size_t i = 0; i < columns.size(); ++i) {
+      if (columns[i].dataset == run.dataset && columns[i].split == run.split) return i;
+    }
+    columns.push_back({run.dataset, run.split, ""});
+    return columns.size() - 1;
+  };
+  std::vector<std::string> labels;
+  std::map<std::pair<std::string, std::size_t>, Row> cells;
+  for (const auto& run : runs) {
+    const std::size_t col = column_of(run);
+    if (std::find(labels.begin(), labels.end(), run.label) == labels.end()) labels.push_back(run.label);
+    Row& cell = cells[{run.label, col}];
+    if (!cell.runs.empty()) {
+      if (!options.group_runs) {
+        throw Error("table: " + cell.runs.front()->dir.string() + " and " + run.dir.string() +
+                    " are both '" + run.label + "' on split '" + run.split + "' of `" +
+                    run.dataset + "`; group them (seeds) with --group-runs");
+      }
+      require_same_characters(run, *cell.runs.front());
+    }
+    cell.label = run.label;
+    cell.runs.push_back(&run);
+  }
+  // Named by split; by dataset too when the test sets come from several dataset files.
+  const bool one_dataset = std::all_of(columns.begin(), columns.end(), [&](const Column& c) {
+    return c.dataset == columns.front().dataset;
+  });
+  for (auto& c : columns) {
+    c.name = one_dataset ? c.split
+                         : fs::path(c.dataset).stem().string() + (c.split == "random" ? "" : " " + c.split);
+  }
+  // Every method of a column on the characters of the column's first method.
+  std::vector<const RunResult*> column_ref(columns.size(), nullptr);
+  for (const auto& run : runs) {
+    const RunResult*& first = column_ref[column_of(run)];
+    if (first == nullptr) first = &run;
+    require_same_characters(run, *first);
+  }
+  const bool union_column = columns.size() > 1;
+  const std::string& reference = labels.front();
+  auto find_cell = [&](const std::string& label, std::size_t col) -> const Row* {
+    const auto at = cells.find({label, col});
+    return at == cells.end() ? nullptr : &at->second;
+  };
+  // The union's per-character values of a method evaluated on every column (else empty).
+  auto pooled = [&](const std::string& label, const std::string& metric) {
+    std::vector<double> all;
+    for (std::size_t col = 0; col < columns.size(); ++col) {
+      const Row* cell = find_cell(label, col);
+      if (cell == nullptr) return std::vector<double>{};
+      const auto v = cell->character_means(metric);
+      all.insert(all.end(), v.begin(), v.end());
+    }
+    return all;
+  };
+
+  std::string out;
+  const bool md = options.format == "md";
+  if (md && !options.title.empty()) out += "### " + options.title + "\n\n";
+  if (options.format == "tex") out += "\\begin{table}\n\\centering\n";
+  for (std::size_t mi = 0; mi < options.metrics.size(); ++mi) {
+    const std::string& m = options.metrics[mi];
+    const eval::ValueDisplay display = eval::value_display(m);
+    std::vector<std::vector<std::string>> table{{display.column_header()}};
+    for (const auto& c : columns) table.front().push_back(c.name);
+    if (union_column) table.front().push_back("all test sets");
+    auto cell_text = [&](const std::vector<double>& values, const std::vector<double>& ref_values,
+                         bool is_reference) {
+      std::string text = value_text(stats_of(values).mean, display);
+      if (!is_reference) {
+        const auto a = anova_of(ref_values, values);
+        if (a) text += " (p " + p_text(a->p) + ")";
+      }
+      return text;
+    };
+    for (const auto& label : labels) {
+      std::vector<std::string> row{label};
+      for (std::size_t col = 0; col < columns.size(); ++col) {
+        const Row* cell = find_cell(label, col);
+        const Row* ref_cell = find_cell(reference, col);
+        if (cell == nullptr) {
+          row.push_back("—");
+          continue;
+        }
+        row.push_back(cell_text(cell->character_means(m),
+                                ref_cell ? ref_cell->character_means(m) : std::vector<double>{},
+                                label == reference || ref_cell == nullptr));
+      }
+      if (union_column) {
+        const auto all = pooled(label, m);
+        const auto ref_all = pooled(reference, m);
+        row.push_back(all.empty() ? "—" : cell_text(all, ref_all, label == reference || ref_all.empty()));
+      }
+      table.push_back(std::move(row));
+    }
+    if (mi > 0) out += md || options.format == "csv" ? "\n" : "\\medskip\n";
+    out += render(table, options.format, 1);
+  }
+  if (options.format == "tex" && !options.title.empty()) {
+    out += "\\caption{" + tex_escape(options.title) + "}\n";
+  }
+  if (options.format == "tex") out += "\\end{table}\n";
+  if (md) {
+    out += "\nMean over each test set's characters";
+    if (options.group_runs) out += " (a method with several runs, e.g. seeds: of each character's mean over its runs)";
+    out += "; (p …): one-way ANOVA over the same characters against " + reference +
+           ". Test sets: ";
+    for (std::size_t col = 0; col < columns.size(); ++col) {
+      const RunResult& r = *column_ref[col];
+      out += fmt::format("{}{}: {} characters, {} part of split '{}' of `{}`", col ? "; " : "",
+                         columns[col].name, r.characters.size(), r.part, r.split, r.dataset);
+    }
+    out += ".\n";
+    out += definitions_text(runs.front());
     if (!options.command.empty()) out += "Generated by `" + options.command + "`.\n";
   }
   return out;

@@ -47,10 +47,27 @@ struct TableOptions {
   std::string format = "md";  ///< md, csv or tex
   std::string title;          ///< a caption line (md: a heading; tex: \caption)
   std::string command;        ///< the command that generated the table, quoted under it
+  /// Runs of one experiment (seeds) form one row: mean ± sample standard deviation across the
+  /// runs of their means over characters; the ANOVA compares each character's mean over the
+  /// runs. Without it every run is a row of its own.
+  bool group_runs = false;
+  /// The generalisation table (make_split_table) instead of one test part.
+  bool across_splits = false;
 };
 
 /// The table text (see the file comment). Throws Error for fewer than one run, an unknown
 /// format, a metric missing from a run (naming both), or runs on different characters.
 std::string make_table(const std::vector<RunResult>& runs, const TableOptions& options);
+
+/// The generalisation table: rows are methods (run labels, in order of appearance), columns are
+/// the test sets the runs were evaluated on (one per dataset and split, e.g. the
+/// leave-one-source-out splits, in order of appearance) and, with more than one, their union
+/// (every character of every column, for a method evaluated on all of them). One such table per
+/// metric; a cell is the mean over its characters and, below the first row, the p of a one-way
+/// ANOVA over characters against the first row's method on the same characters. A cell with
+/// several runs of one method needs `group_runs` (then each character's mean over the runs).
+/// make_table dispatches here when `options.across_splits` is set. Throws Error as make_table,
+/// and when a cell's runs, or a column's methods, were evaluated on different characters.
+std::string make_split_table(const std::vector<RunResult>& runs, const TableOptions& options);
 
 }  // namespace skinlab::report

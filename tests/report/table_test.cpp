@@ -1,7 +1,8 @@
 // `skinlab table`'s core on two tiny saved runs written here: the exact Markdown (means, sample
 // standard deviations and ANOVA F/p computed by hand: for two groups of two, p of F(1, 2) is
 // 1 − t/√(t² + 2) with t = √F), the thresholds quoted from the run config, CSV and LaTeX, and
-// the errors for runs on different characters, a missing metric and a missing evaluation.
+// the errors for runs on different characters, a missing metric and a missing evaluation; runs
+// of one experiment grouped into one row (seeds); the generalisation table across test sets.
 
 #include <gtest/gtest.h>
 
@@ -21,18 +22,19 @@ using testing::TempDir;
 /// A run directory with only what `skinlab eval` leaves for the table: eval_test.json.
 fs::path saved_run(const TempDir& dir, const std::string& experiment,
                    const std::vector<std::string>& characters,
-                   const std::map<std::string, std::vector<double>>& values) {
+                   const std::map<std::string, std::vector<double>>& values,
+                   const std::string& run = "r1", const std::string& split = "random") {
   nlohmann::json per = nlohmann::json::array();
   for (std::size_t i = 0; i < characters.size(); ++i) {
     nlohmann::json v;
     for (const auto& [name, x] : values) v[name] = x[i];
     per.push_back({{"character", characters[i]}, {"vertices", 10}, {"bones", 3}, {"values", v}});
   }
-  const nlohmann::json j = {{"experiment", experiment}, {"run", "r1"},         {"dataset", "d.h5"},
-                            {"split", "random"},        {"part", "test"},      {"checkpoint", "best"},
+  const nlohmann::json j = {{"experiment", experiment}, {"run", run},      {"dataset", "d.h5"},
+                            {"split", split},           {"part", "test"}, {"checkpoint", "best"},
                             {"epoch", 3},               {"per_character", per}};
-  dir.write(experiment + "/r1/eval_test.json", j.dump());
-  return dir / experiment / "r1";
+  dir.write(experiment + "/" + run + "/eval_test.json", j.dump());
+  return dir / experiment / run;
 }
 
 struct Runs {
@@ -113,6 +115,59 @@ TEST(Table, RunsOnOtherCharactersMissingMetricsAndMissingEvaluationsAreErrors) {
   report::TableOptions bad;
   bad.format = "html";
   testing::expect_error<Error>([&] { report::make_table({ours}, bad); }, {"unknown format 'html'"});
+}
+
+
+TEST(Table, GroupedRunsGiveMeanAndSdAcrossRunsAndAnovaOnCharacterMeans) {
+  const TempDir dir;
+  const auto s0 = report::load_run_result(saved_run(dir, "ours", {"a", "b"}, {{"precision", {0.8, 0.6}}}, "s0"), "test");
+  const auto s1 = report::load_run_result(saved_run(dir, "ours", {"a", "b"}, {{"precision", {0.6, 0.4}}}, "s1"), "test");
+  const auto other = report::load_run_result(saved_run(dir, "other", {"a", "b"}, {{"precision", {0.4, 0.6}}}), "test");
+  report::TableOptions o;
+  o.metrics = {"precision"};
+  o.group_runs = true;
+  const std::string md = report::make_table({s0, other, s1}, o);
+  // run means 0.7 and 0.5; character means (0.7, 0.5) against (0.4, 0.6): F(1, 2) = 0.5
+  EXPECT_NE(md.find("| Method | Runs | Precision ↑ |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| ours | s0, s1 | 60.00% ± 14.14% |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| other | r1 | 50.00% ± 14.14% |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| other | 0.5000 (0.5528) |"), std::string::npos) << md;
+  EXPECT_NE(md.find("mean over the runs"), std::string::npos) << md;
+  // without grouping the seeds are two rows told apart by their run ids
+  o.group_runs = false;
+  const std::string rows = report::make_table({s0, other, s1}, o);
+  EXPECT_NE(rows.find("| ours (s1) | "), std::string::npos) << rows;
+}
+
+TEST(Table, AcrossSplitsHasAColumnPerTestSetAndTheirUnion) {
+  const TempDir dir;
+  auto run = [&](const std::string& e, const std::vector<std::string>& c, std::vector<double> p,
+                 const std::string& split) {
+    return report::load_run_result(saved_run(dir, e, c, {{"precision", p}}, "r-" + split, split), "test");
+  };
+  const std::vector<report::RunResult> runs{
+      run("ours", {"a", "b"}, {0.8, 0.6}, "leave_out_x"), run("ours", {"c", "d"}, {0.9, 0.7}, "leave_out_y"),
+      run("other", {"a", "b"}, {0.4, 0.6}, "leave_out_x"), run("other", {"c", "d"}, {0.5, 0.5}, "leave_out_y"),
+      run("third", {"c", "d"}, {0.7, 0.7}, "leave_out_y")};
+  report::TableOptions o;
+  o.metrics = {"precision"};
+  o.across_splits = true;
+  const std::string md = report::make_table(runs, o);
+  EXPECT_NE(md.find("| Precision ↑ | leave_out_x | leave_out_y | all test sets |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| ours | 70.00% | 80.00% | 75.00% |"), std::string::npos) << md;
+  // F(1, 2) = 2 on x (as in the first test) and 9 on y: p = 1 - 3 / sqrt(11)
+  EXPECT_NE(md.find("| other | 50.00% (p 0.2929) | 50.00% (p 0.0955) | 50.00% (p "), std::string::npos) << md;
+  EXPECT_NE(md.find("| third | — | 70.00% (p 0.4226) | — |"), std::string::npos) << md;
+  EXPECT_NE(md.find("leave_out_y: 2 characters, test part of split 'leave_out_y'"), std::string::npos) << md;
+
+  // two runs of one method on one test set need --group-runs; a test set's methods must share
+  // its characters
+  testing::expect_error<Error>(
+      [&] { report::make_table({runs[0], run("ours", {"a", "b"}, {0.1, 0.2}, "leave_out_x")}, o); },
+      {"both 'ours'", "--group-runs"});
+  testing::expect_error<Error>(
+      [&] { report::make_table({runs[0], run("other", {"a", "e"}, {0.1, 0.2}, "leave_out_x")}, o); },
+      {"evaluated on other characters", "'e' where"});
 }
 
 }  // namespace SKINLAB_UNITY_ID
