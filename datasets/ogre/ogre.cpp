@@ -20,42 +20,50 @@ namespace skinlab::datasets {
 
 namespace fs = std::filesystem;
 
-OgreBuilder::Options OgreBuilder::Options::from(const config::Node& node) {
-  Options o;
-  config::Fields f(node, "dataset 'ogre'");
-  o.source = RepositorySource::from(f, node);
-  f.optional("licence", o.licence);
-  f.optional("attribution", o.attribution);
-  f.optional("animations", o.animations);
-  f.optional("max_animations_per_character", o.max_animations_per_character);
-  f.optional("fps", o.fps);
-  f.optional("join_weighted_roots", o.join_weighted_roots);
-  f.optional("max_unweighted_fraction", o.max_unweighted_fraction);
-  f.optional("up", o.up);
-  const config::Node credits = f.section("credits");
-  if (credits.exists() && !credits.is_null()) {
-    if (!credits.is_sequence()) credits.fail("expected a list of {files, licence, attribution}");
-    for (std::size_t i = 0; i < credits.size(); ++i) {
+namespace ogre {
+
+void TreeOptions::read(config::Fields& f, const std::string& owner) {
+  f.optional("licence", licence);
+  f.optional("attribution", attribution);
+  f.optional("animations", animations);
+  f.optional("max_animations_per_character", max_animations_per_character);
+  f.optional("fps", fps);
+  f.optional("join_weighted_roots", join_weighted_roots);
+  f.optional("max_unweighted_fraction", max_unweighted_fraction);
+  f.optional("up", up);
+  const config::Node credit_list = f.section("credits");
+  if (credit_list.exists() && !credit_list.is_null()) {
+    if (!credit_list.is_sequence()) credit_list.fail("expected a list of {files, licence, attribution}");
+    for (std::size_t i = 0; i < credit_list.size(); ++i) {
       Credit c;
-      config::Fields cf(credits[i], "dataset 'ogre' credit", {});
+      config::Fields cf(credit_list[i], owner + " credit", {});
       cf.required("files", c.files);
       cf.required("licence", c.licence);
       cf.optional("attribution", c.attribution);
       cf.finish();
-      o.credits.push_back(c);
+      credits.push_back(c);
     }
   }
-  const config::Node exclude = f.section("exclude");
-  if (exclude.exists() && !exclude.is_null()) {
-    if (!exclude.is_map()) exclude.fail("expected a map of path glob → reason");
-    for (const auto& glob : exclude.keys()) o.exclude.emplace_back(glob, exclude[glob].as<std::string>());
+  const config::Node exclusions = f.section("exclude");
+  if (exclusions.exists() && !exclusions.is_null()) {
+    if (!exclusions.is_map()) exclusions.fail("expected a map of path glob → reason");
+    for (const auto& glob : exclusions.keys()) exclude.emplace_back(glob, exclusions[glob].as<std::string>());
   }
-  f.check(o.max_animations_per_character >= 0, "max_animations_per_character", "must be ≥ 0");
-  f.check(o.fps > 0, "fps", "must be positive");
-  f.check(o.up.size() == 3 && (o.up[0] != 0 || o.up[1] != 0 || o.up[2] != 0), "up",
+  f.check(max_animations_per_character >= 0, "max_animations_per_character", "must be ≥ 0");
+  f.check(fps > 0, "fps", "must be positive");
+  f.check(up.size() == 3 && (up[0] != 0 || up[1] != 0 || up[2] != 0), "up",
           "must be a non-zero vector [x, y, z]");
-  f.check(o.max_unweighted_fraction >= 0 && o.max_unweighted_fraction <= 1,
+  f.check(max_unweighted_fraction >= 0 && max_unweighted_fraction <= 1,
           "max_unweighted_fraction", "must be in [0, 1]");
+}
+
+}  // namespace ogre
+
+OgreBuilder::Options OgreBuilder::Options::from(const config::Node& node) {
+  Options o;
+  config::Fields f(node, "dataset 'ogre'");
+  o.source = RepositorySource::from(f, node);
+  o.read(f, "dataset 'ogre'");
   f.finish();
   return o;
 }
@@ -118,6 +126,23 @@ struct WeightStats {
 /// Name of the weightless joint added above several weighted root bones.
 const std::string kOriginJoint = "ogre_origin";
 
+/// The directory part of a tree path ("" at the root).
+std::string tree_dir(const std::string& path) {
+  const auto slash = path.rfind('/');
+  return slash == std::string::npos ? std::string() : path.substr(0, slash);
+}
+
+std::string tree_filename(const std::string& path) {
+  const auto slash = path.rfind('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+std::string tree_extension(const std::string& path) {
+  const std::string name = tree_filename(path);
+  const auto dot = name.rfind('.');
+  return dot == std::string::npos ? std::string() : ogre_lower(name.substr(dot));
+}
+
 }  // namespace
 
 std::vector<SourceCharacter> OgreBuilder::read(std::vector<Excluded>& excluded) const {
@@ -130,55 +155,73 @@ std::vector<SourceCharacter> OgreBuilder::read(std::vector<Excluded>& excluded) 
                        : " (repository " + options_.source.repository + " at " +
                              options_.source.commit + ")"));
   }
-  std::vector<fs::path> meshes;
-  std::map<std::string, std::vector<fs::path>> skeletons_by_name;  // lower-case file name
+  std::vector<fs::path> files;
   try {
     for (const auto& e : fs::recursive_directory_iterator(dir)) {
-      if (!e.is_regular_file()) continue;
       const std::string ext = ogre_lower(e.path().extension().string());
-      if (ext == ".mesh") meshes.push_back(e.path());
-      if (ext == ".skeleton") skeletons_by_name[ogre_lower(e.path().filename().string())].push_back(e.path());
+      if (e.is_regular_file() && (ext == ".mesh" || ext == ".skeleton")) files.push_back(e.path());
     }
   } catch (const fs::filesystem_error& e) {
     throw IoError(dir.string() + ": dataset 'ogre': cannot list directory: " + e.what());
   }
-  std::sort(meshes.begin(), meshes.end());
+  std::sort(files.begin(), files.end());  // path order (by component)
+  ogre::Tree tree;
+  tree.source = options_.source.label("ogre");
+  tree.where = dir.string();
+  for (const fs::path& file : files) {
+    tree.files.push_back({file.lexically_relative(dir).generic_string(),
+                          [file] { return read_binary_file(file); }});
+  }
+  return ogre::read_tree(tree, options_, excluded);
+}
+
+std::vector<SourceCharacter> ogre::read_tree(const Tree& tree, const TreeOptions& options,
+                                             std::vector<Excluded>& excluded) {
+  std::map<std::string, const TreeFile*> by_path;
+  std::map<std::string, std::vector<std::string>> skeletons_by_name;  // lower-case file name
+  std::vector<const TreeFile*> meshes;
+  for (const TreeFile& file : tree.files) {
+    const std::string ext = tree_extension(file.path);
+    by_path.emplace(file.path, &file);
+    if (ext == ".mesh") meshes.push_back(&file);
+    if (ext == ".skeleton") skeletons_by_name[ogre_lower(tree_filename(file.path))].push_back(file.path);
+  }
   for (auto& [name, paths] : skeletons_by_name) std::sort(paths.begin(), paths.end());
 
   // Parsed skeletons by path (several meshes share one); a parse error is kept as its message.
-  std::map<fs::path, std::pair<std::shared_ptr<ogre::OgreSkeleton>, std::string>> skeleton_cache;
-  auto load_skeleton = [&](const fs::path& file) {
-    auto it = skeleton_cache.find(file);
+  std::map<std::string, std::pair<std::shared_ptr<OgreSkeleton>, std::string>> skeleton_cache;
+  auto load_skeleton = [&](const std::string& path) {
+    auto it = skeleton_cache.find(path);
     if (it == skeleton_cache.end()) {
-      std::pair<std::shared_ptr<ogre::OgreSkeleton>, std::string> entry;
+      std::pair<std::shared_ptr<OgreSkeleton>, std::string> entry;
       try {
-        const std::string bytes = read_binary_file(file);
-        entry.first = std::make_shared<ogre::OgreSkeleton>(
-            ogre::parse_skeleton(bytes, file.lexically_relative(dir).generic_string()));
+        entry.first = std::make_shared<OgreSkeleton>(parse_skeleton(by_path.at(path)->load(), path));
       } catch (const Error& e) {
         entry.second = e.what();
       }
-      it = skeleton_cache.emplace(file, entry).first;
+      it = skeleton_cache.emplace(path, entry).first;
     }
     if (!it->second.first) throw IoError(it->second.second);
     return it->second.first;
   };
-  auto resolve_skeleton = [&](const fs::path& mesh, const std::string& link,
-                              const std::string& rel) -> fs::path {
-    const fs::path next = mesh.parent_path() / link;
-    if (fs::is_regular_file(next, ec)) return next;
-    const std::string wanted = ogre_lower(fs::path(link).filename().string());
-    for (const auto& e : fs::directory_iterator(mesh.parent_path(), ec)) {
-      if (e.is_regular_file() && ogre_lower(e.path().filename().string()) == wanted) return e.path();
+  // As OGRE's resource groups find it: next to the mesh, then case-insensitively next to it,
+  // then by its (case-insensitive) file name anywhere, which must be unique.
+  auto resolve_skeleton = [&](const std::string& rel, const std::string& link) -> std::string {
+    const std::string dir = tree_dir(rel);
+    const std::string next = fs::path(dir.empty() ? link : dir + "/" + link).lexically_normal().generic_string();
+    if (by_path.count(next)) return next;
+    const std::string wanted = ogre_lower(tree_filename(fs::path(link).generic_string()));
+    for (const auto& [path, file] : by_path) {
+      if (tree_dir(path) == dir && ogre_lower(tree_filename(path)) == wanted) return path;
     }
     const auto found = skeletons_by_name.find(wanted);
     if (found == skeletons_by_name.end()) {
       throw IoError(rel + ": its skeleton '" + link + "' is not next to it nor anywhere under " +
-                    dir.string());
+                    tree.where);
     }
     if (found->second.size() > 1) {
       std::string list;
-      for (const auto& p : found->second) list += " " + p.lexically_relative(dir).generic_string();
+      for (const auto& p : found->second) list += " " + p;
       throw IoError(rel + ": its skeleton '" + link + "' is not next to it and several files " +
                     "elsewhere have that name:" + list);
     }
@@ -186,17 +229,16 @@ std::vector<SourceCharacter> OgreBuilder::read(std::vector<Excluded>& excluded) 
   };
 
   std::vector<SourceCharacter> out;
-  for (const fs::path& file : meshes) {
-    const std::string rel = file.lexically_relative(dir).generic_string();
-    const auto excluded_by = std::find_if(options_.exclude.begin(), options_.exclude.end(),
+  for (const TreeFile* file : meshes) {
+    const std::string& rel = file->path;
+    const auto excluded_by = std::find_if(options.exclude.begin(), options.exclude.end(),
                                           [&](const auto& e) { return glob_matches(e.first, rel); });
-    if (excluded_by != options_.exclude.end()) {
-      excluded.push_back({options_.source.label("ogre"), rel, "excluded by the config (" + excluded_by->first + "): " + excluded_by->second});
+    if (excluded_by != options.exclude.end()) {
+      excluded.push_back({tree.source, rel, "excluded by the config (" + excluded_by->first + "): " + excluded_by->second});
       continue;
     }
     try {
-      const std::string bytes = read_binary_file(file);
-      const ogre::OgreMesh mesh = ogre::parse_mesh(bytes, rel);
+      const OgreMesh mesh = parse_mesh(file->load(), rel);
       if (mesh.skeleton_link.empty()) {
         throw geometry::GeometryError(rel + ": a static mesh (no skeleton link): a prop or an "
                                       "attachment, not a skinned character");
@@ -205,7 +247,7 @@ std::vector<SourceCharacter> OgreBuilder::read(std::vector<Excluded>& excluded) 
         throw geometry::GeometryError(rel + ": links skeleton '" + mesh.skeleton_link +
                                       "' but has no bone assignments");
       }
-      const fs::path skeleton_file = resolve_skeleton(file, mesh.skeleton_link, rel);
+      const std::string skeleton_file = resolve_skeleton(rel, mesh.skeleton_link);
       const auto skeleton = load_skeleton(skeleton_file);
       const int num_bones = static_cast<int>(skeleton->bones.size());
 
@@ -217,7 +259,7 @@ std::vector<SourceCharacter> OgreBuilder::read(std::vector<Excluded>& excluded) 
         if (a.bone >= num_bones) {
           throw geometry::GeometryError(rel + ": vertex " + std::to_string(a.vertex) +
                                         " is assigned to bone " + std::to_string(a.bone) + ", but " +
-                                        skeleton_file.filename().string() + " has " +
+                                        tree_filename(skeleton_file) + " has " +
                                         std::to_string(num_bones) + " bones");
         }
         if (a.weight <= 0) continue;
@@ -244,11 +286,11 @@ std::vector<SourceCharacter> OgreBuilder::read(std::vector<Excluded>& excluded) 
           ++stats.dropped_free;
         }
       }
-      if (unweighted_used > options_.max_unweighted_fraction * nv) {
+      if (unweighted_used > options.max_unweighted_fraction * nv) {
         throw geometry::GeometryError(
             rel + ": " + std::to_string(unweighted_used) + " of " + std::to_string(nv) +
             " vertices used by triangles have no bone assignment (more than " +
-            std::to_string(options_.max_unweighted_fraction) + " of the vertices)");
+            std::to_string(options.max_unweighted_fraction) + " of the vertices)");
       }
       std::vector<Eigen::Vector3i> faces;
       for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
@@ -280,16 +322,19 @@ std::vector<SourceCharacter> OgreBuilder::read(std::vector<Excluded>& excluded) 
       }
       int weighted_roots = 0;
       for (int b = 0; b < num_bones; ++b) weighted_roots += skeleton->bones[b].parent < 0 && subtree[b] > 0;
-      const bool origin = weighted_roots > 1 && options_.join_weighted_roots;
+      const bool origin = weighted_roots > 1 && options.join_weighted_roots;
       const int first = origin ? 1 : 0;  // model joint of order[0]
       std::vector<int> joint_of(num_bones);
       for (int k = 0; k < num_bones; ++k) joint_of[order[k]] = first + k;
-      const ogre::BindPose bind = ogre::derive_bind_pose(*skeleton);
+      const BindPose bind = derive_bind_pose(*skeleton);
 
       RiggedModel model;
-      std::string name = fs::path(rel).replace_extension().generic_string();
-      std::replace(name.begin(), name.end(), '/', '.');
-      model.name = name;
+      if (tree.name) {
+        model.name = tree.name(rel);
+      } else {
+        model.name = fs::path(rel).replace_extension().generic_string();
+        std::replace(model.name.begin(), model.name.end(), '/', '.');
+      }
       if (origin) {
         model.joint_names.push_back(kOriginJoint);
         model.parents.push_back(-1);
@@ -297,7 +342,7 @@ std::vector<SourceCharacter> OgreBuilder::read(std::vector<Excluded>& excluded) 
       }
       for (int k = 0; k < num_bones; ++k) {
         const int h = order[k];
-        const ogre::OgreBone& b = skeleton->bones[h];
+        const OgreBone& b = skeleton->bones[h];
         if (origin && b.name == kOriginJoint) {
           throw geometry::GeometryError(rel + ": a bone is named '" + kOriginJoint +
                                         "', the name of the joint added above its roots");
@@ -342,14 +387,14 @@ std::vector<SourceCharacter> OgreBuilder::read(std::vector<Excluded>& excluded) 
       SourceRig rig = to_source_rig(model);
 
       SourceCharacter sc;
-      sc.source = options_.source.label("ogre");
+      sc.source = tree.source;
       sc.path = rel;
-      sc.skeleton = skeleton_file.stem().string();
-      sc.up = Eigen::Vector3d(options_.up[0], options_.up[1], options_.up[2]).normalized();
-      sc.licence = options_.licence;
-      sc.attribution = options_.attribution;
-      const std::string filename = file.filename().string();
-      for (const Credit& c : options_.credits) {
+      sc.skeleton = fs::path(tree_filename(skeleton_file)).stem().string();
+      sc.up = Eigen::Vector3d(options.up[0], options.up[1], options.up[2]).normalized();
+      sc.licence = options.licence;
+      sc.attribution = options.attribution;
+      const std::string filename = tree_filename(rel);
+      for (const TreeOptions::Credit& c : options.credits) {
         if (glob_matches(c.files, rel) || glob_matches(c.files, filename)) {
           sc.licence = c.licence;
           sc.attribution = c.attribution;
@@ -358,14 +403,14 @@ std::vector<SourceCharacter> OgreBuilder::read(std::vector<Excluded>& excluded) 
       }
 
       int clips_scaled = 0;
-      if (options_.animations) {
+      if (options.animations) {
         for (const auto& clip : skeleton->animations) {
-          if (static_cast<int>(sc.animations.size()) >= options_.max_animations_per_character) break;
-          const int frames = static_cast<int>(std::floor(clip.length * options_.fps + 1e-9)) + 1;
+          if (static_cast<int>(sc.animations.size()) >= options.max_animations_per_character) break;
+          const int frames = static_cast<int>(std::floor(clip.length * options.fps + 1e-9)) + 1;
           std::vector<Transforms> global(frames);
           bool rigid = true;
           for (int f = 0; f < frames && rigid; ++f) {
-            const ogre::BindPose pose = ogre::sample_animation(*skeleton, clip, f / options_.fps);
+            const BindPose pose = sample_animation(*skeleton, clip, f / options.fps);
             global[f].assign(num_joints, Eigen::Isometry3d::Identity());
             for (int k = 0; k < num_bones; ++k) {
               const int h = order[k];
@@ -385,16 +430,16 @@ std::vector<SourceCharacter> OgreBuilder::read(std::vector<Excluded>& excluded) 
             ++clips_scaled;
             continue;
           }
-          sc.animations.push_back(make_animation(clip.name, options_.fps, global, rig));
+          sc.animations.push_back(make_animation(clip.name, options.fps, global, rig));
         }
       }
       spdlog::info(
-          "ogre: {}: {} vertices, {} triangles, {} of {} bones kept{}, skeleton {}; weights: {} "
+          "{}: {}: {} vertices, {} triangles, {} of {} bones kept{}, skeleton {}; weights: {} "
           "vertices renormalised, {} cut to 4 bones, {} repeated assignments summed; dropped: {} "
           "free vertices, {} unweighted vertices with {} triangles; {} of {} clips kept{}",
-          rel, rig.character.mesh.V.rows(), rig.character.mesh.F.rows(), rig.kept.size() - first,
+          tree.source, rel, rig.character.mesh.V.rows(), rig.character.mesh.F.rows(), rig.kept.size() - first,
           num_bones, origin ? " under an added '" + kOriginJoint + "' joint (" + std::to_string(weighted_roots) + " weighted roots)" : "",
-          skeleton_file.lexically_relative(dir).generic_string(), stats.renormalised,
+          skeleton_file, stats.renormalised,
           stats.trimmed, stats.merged, stats.dropped_free, stats.dropped_unweighted,
           stats.dropped_faces, sc.animations.size(),
           skeleton->animations.size(),
@@ -402,7 +447,7 @@ std::vector<SourceCharacter> OgreBuilder::read(std::vector<Excluded>& excluded) 
       sc.character = std::move(rig.character);
       out.push_back(std::move(sc));
     } catch (const std::exception& e) {  // Error, and e.g. bad_alloc on absurd counts
-      excluded.push_back({options_.source.label("ogre"), rel, e.what()});
+      excluded.push_back({tree.source, rel, e.what()});
     }
   }
   return out;

@@ -47,7 +47,11 @@
 /// `max_animations_per_character`. A clip that changes the derived scale of a kept joint
 /// relative to the bind pose cannot be written as rigid transforms and is left out (logged;
 /// the next clip takes its place).
+///
+/// Everything above but the directory listing is ogre::read_tree, which other builders reuse on
+/// the files of an archive (datasets/openclonk/openclonk.hpp: OpenClonk's C4Group files).
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -57,34 +61,71 @@
 
 namespace skinlab::datasets {
 
-class OgreBuilder final : public DatasetBuilder {
- public:
+namespace ogre {
+
+/// How a tree of OGRE files becomes characters: the options shared by the `ogre` builder and
+/// the builders that read OGRE files out of archives (the config keys of the same names).
+struct TreeOptions {
   /// Licence and attribution of the files matching a glob (from the source's credits file).
   struct Credit {
     std::string files;        ///< glob on the relative path or file name, e.g. "Orc.*"
     std::string licence;      ///< SPDX-style
     std::string attribution;  ///< authors (and where the credit comes from)
   };
-  struct Options {
+  std::string licence;      ///< SPDX-style licence of files no credit matches
+  std::string attribution;  ///< authors of files no credit matches
+  std::vector<Credit> credits;
+  /// Glob on the relative path → reason: meshes that are not characters.
+  std::vector<std::pair<std::string, std::string>> exclude;
+  bool animations = true;
+  int max_animations_per_character = 8;
+  double fps = 24;
+  /// Put several weighted root bones under an added weightless joint at the origin.
+  bool join_weighted_roots = true;
+  /// Largest share of vertices used by triangles but without bone assignment that is
+  /// dropped (with their triangles) instead of excluding the mesh.
+  double max_unweighted_fraction = 0.01;
+  /// The up direction of the files' model space (SourceCharacter::up): OGRE's convention is
+  /// +Y (Summoning Wars), but OpenDungeons models stand on z = 0 with +Z up.
+  std::vector<double> up = {0, 1, 0};
+
+  /// Reads the keys above through `f` (`credits` and `exclude` are sections of it) and checks
+  /// them; `owner` names the builder in messages, e.g. "dataset 'ogre'".
+  void read(config::Fields& f, const std::string& owner);
+};
+
+/// A file of a tree: its path relative to the tree's root ('/'-separated) and its bytes, read
+/// on demand (from a directory, or out of an archive).
+struct TreeFile {
+  std::string path;
+  std::function<std::string()> load;
+};
+
+/// A tree of files holding `.mesh` and `.skeleton` files (other files are ignored).
+struct Tree {
+  std::string source;  ///< SourceCharacter::source and Excluded::source of what is read
+  std::string where;   ///< the tree's location, for messages (a directory, an archive)
+  /// Every file, meshes in the order they become characters.
+  std::vector<TreeFile> files;
+  /// The character name of the mesh at a path; empty: the path without `.mesh`, '/' → '.'.
+  std::function<std::string(const std::string&)> name;
+};
+
+/// The characters of every `.mesh` of `tree`, by the rules of this file's header (exclusions,
+/// skeleton look-up, OGRE's weights, joints, clips); a mesh that fails goes to `excluded`
+/// with its reason, named by its path in the tree.
+std::vector<SourceCharacter> read_tree(const Tree& tree, const TreeOptions& options,
+                                       std::vector<Excluded>& excluded);
+
+}  // namespace ogre
+
+class OgreBuilder final : public DatasetBuilder {
+ public:
+  using Credit = ogre::TreeOptions::Credit;
+  struct Options : ogre::TreeOptions {
     /// Directory of the .mesh/.skeleton files: `path`, or `repository` + `commit` + `path`
     /// inside it (datasets/repository.hpp).
     RepositorySource source;
-    std::string licence;      ///< SPDX-style licence of files no credit matches
-    std::string attribution;  ///< authors of files no credit matches
-    std::vector<Credit> credits;
-    /// Glob on the relative path → reason: meshes that are not characters.
-    std::vector<std::pair<std::string, std::string>> exclude;
-    bool animations = true;
-    int max_animations_per_character = 8;
-    double fps = 24;
-    /// Put several weighted root bones under an added weightless joint at the origin.
-    bool join_weighted_roots = true;
-    /// Largest share of vertices used by triangles but without bone assignment that is
-    /// dropped (with their triangles) instead of excluding the mesh.
-    double max_unweighted_fraction = 0.01;
-    /// The up direction of the files' model space (SourceCharacter::up): OGRE's convention is
-    /// +Y (Summoning Wars), but OpenDungeons models stand on z = 0 with +Z up.
-    std::vector<double> up = {0, 1, 0};
     static Options from(const config::Node& node);
   };
 

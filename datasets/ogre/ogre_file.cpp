@@ -116,22 +116,23 @@ class Cursor {
     std::string what() const { return "chunk " + hex(id); }
     std::size_t end() const { return start + length; }
   };
-  /// Reads a chunk header; OGRE's check: the length covers at least the header and ends
-  /// inside the file.
-  Chunk chunk(const std::string& context) {
+  /// How a chunk's length is used: to skip the chunk or to size its contents (kInside: it must
+  /// end inside the file), or not at all because the contents are read item by item to their
+  /// end (kSequential: only `length` ≥ 6 is checked; skip_rest() checks the end if it is used).
+  enum class Extent { kInside, kSequential };
+
+  /// Reads a chunk header; OGRE's check: the length covers at least the header and, for a
+  /// chunk whose length is used, ends inside the file.
+  Chunk chunk(const std::string& context, Extent extent = Extent::kInside) {
     Chunk c;
     c.start = pos_;
     c.id = u16(context + ": chunk id");
     c.length = u32(context + ": chunk " + hex(c.id) + " length");
-    if (c.length < kChunkHeader || c.start + c.length > reader_.size()) {
+    if (c.length < kChunkHeader) {
       reader_.fail(c.start, context + ": chunk " + hex(c.id),
-                   "corrupt chunk length " + std::to_string(c.length) +
-                       (c.length < kChunkHeader ? std::string(" (below the 6-byte header)")
-                                                : " (runs past the end: the file has " +
-                                                      std::to_string(reader_.size()) +
-                                                      " bytes; truncated, or miscounted by its "
-                                                      "exporter)"));
+                   "corrupt chunk length " + std::to_string(c.length) + " (below the 6-byte header)");
     }
+    if (extent == Extent::kInside) require_inside(c, context + ": chunk " + hex(c.id));
     return c;
   }
   /// The id of the next chunk without consuming it, or nothing at the end of the data.
@@ -140,8 +141,17 @@ class Cursor {
     return reader_.u16(pos_, "chunk id");
   }
   void skip_rest(const Chunk& c) {
+    require_inside(c, c.what());
     if (c.end() < pos_) reader_.fail(c.start, c.what(), "chunk ends before its contents");
     pos_ = c.end();
+  }
+  void require_inside(const Chunk& c, const std::string& what) const {
+    if (c.start + c.length > reader_.size()) {
+      reader_.fail(c.start, what,
+                   "corrupt chunk length " + std::to_string(c.length) +
+                       " (runs past the end: the file has " + std::to_string(reader_.size()) +
+                       " bytes; truncated, or miscounted by its exporter)");
+    }
   }
   [[noreturn]] void fail(std::size_t offset, const std::string& what,
                          const std::string& message) const {
@@ -288,7 +298,10 @@ OgreMesh parse_mesh(std::string_view data, const std::string& source) {
   int shared_offset = -1, shared_count = 0;
   std::vector<Eigen::Vector3i> faces;
   while (!in.at_end()) {
-    const auto top = in.chunk("top level");
+    // M_MESH is read item by item to its end (OGRE's readMesh, OpenClonk's ChunkMesh): its
+    // length is never used, and OpenClonk's [MeshSerializer_v1.8] Clonk outfits store one that
+    // ends a byte past the file.
+    const auto top = in.chunk("top level", Cursor::Extent::kSequential);
     if (top.id != kMesh) {  // OGRE's importMesh reads only M_MESH
       in.skip_rest(top);
       continue;

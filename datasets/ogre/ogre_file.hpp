@@ -11,6 +11,11 @@
 /// the `[MeshSerializer_v1.41]` era write sub-mesh lengths that are 6 bytes short (Summoning
 /// Wars' fire_slug.mesh), and the skeleton serialiser's bone lengths never count the bone name
 /// (OGRE decides "has a scale" by comparing the length with 36 bytes; so does this reader).
+/// A length must end inside the file where it is used (to skip a chunk); the mesh chunk
+/// (M_MESH), which is read item by item, may claim more: OpenClonk's exporter wrote
+/// `GraphicsAlchemist.mesh` and `GraphicsSteampunk.mesh` with an M_MESH length one byte past the
+/// end of the file, which OpenClonk's own loader (StdMeshLoaderBinaryChunks.cpp) never looks at,
+/// nor does OGRE's importMesh outside its debug-build chunk validation.
 ///
 /// Mesh versions read: `[MeshSerializer_v1.100]`, `v1.10`, `v1.8`, `v1.41`, `v1.40`, `v1.30`.
 /// Between these versions only chunks this reader skips differ (LOD levels, edge lists, poses,

@@ -280,9 +280,10 @@ TEST(Ogre, TruncatedFilesAreExcludedWithTheFileNamed) {
           << "cut at " << n << ": " << excluded[0].reason;
     }
   }
+  // The mesh chunk's length is not used (it is read item by item); its first sub-mesh's is.
   testing::expect_error<IoError>(
       [&] { ogre::parse_mesh(mesh.substr(0, 1000), "Knight.mesh"); },
-      {"Knight.mesh: top level: chunk 0x3000 (byte offset 26)", "corrupt chunk length 24919",
+      {"Knight.mesh: mesh: chunk 0x4000 (byte offset 33)", "corrupt chunk length 4435",
        "the file has 1000 bytes"});
   testing::expect_error<IoError>(
       [&] { ogre::parse_skeleton(skeleton.substr(0, 100), "Knight.skeleton"); },
@@ -294,6 +295,25 @@ TEST(Ogre, TruncatedFilesAreExcludedWithTheFileNamed) {
   huge[geometry + 6 + 3] = '\x7f';  // its vertex count's high byte
   testing::expect_error<IoError>([&] { ogre::parse_mesh(huge, "Knight.mesh"); },
                                  {"Knight.mesh: ", "geometry", "byte offset"});
+}
+
+TEST(OgreFile, MeshChunkLengthPastTheEndIsRead) {
+  // OpenClonk's GraphicsAlchemist.mesh and GraphicsSteampunk.mesh store an M_MESH length one
+  // byte past the end of the file; the chunk is read item by item, as OpenClonk's loader does.
+  const std::string mesh = read_binary_file(kKnightMesh);
+  std::string longer = mesh;
+  ASSERT_EQ(longer.substr(26, 2), std::string("\x00\x30", 2));  // M_MESH after the header
+  longer[28] = static_cast<char>(longer[28] + 1);  // its length's low byte (24919 → 24920)
+  const ogre::OgreMesh a = ogre::parse_mesh(mesh, "Knight.mesh");
+  const ogre::OgreMesh b = ogre::parse_mesh(longer, "Knight.mesh");
+  EXPECT_EQ(a.V, b.V);
+  EXPECT_EQ(a.F, b.F);
+  EXPECT_EQ(a.assignments.size(), b.assignments.size());
+  // A chunk the reader skips by its length must end inside the file.
+  std::string skipped = mesh;
+  skipped[26] = '\x00', skipped[27] = '\x70';  // not M_MESH: a top-level chunk to skip
+  testing::expect_error<IoError>([&] { ogre::parse_mesh(skipped.substr(0, 1000), "Knight.mesh"); },
+                                 {"Knight.mesh: chunk 0x7000 (byte offset 26)", "corrupt chunk length 24919"});
 }
 
 TEST(Ogre, CorruptedFilesNeverCrash) {
