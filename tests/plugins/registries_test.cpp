@@ -28,7 +28,7 @@ TEST(Registry, ExactKeysOfEveryCategory) {
       {"corrective_model", {"densegats", "neuroskinning"}},
       {"loss", {"kl", "laplacian_smoothing", "mse", "soft_cross_entropy"}},
       {"metric", {"avg_l1", "deformation_error", "dominant_joint", "precision_recall"}},
-      {"dataset", {"cube2", "folder", "nexuiz", "ogre", "zeroad"}},
+      {"dataset", {"cube2", "folder", "nexuiz", "ogre", "openclonk", "zeroad"}},
       {"binder", {"bone_heat", "geo_voxel"}},
       {"task", {"corrective", "sequence", "skinning"}},
   };
