@@ -21,7 +21,6 @@
 #include <array>
 #include <iostream>
 #include <map>
-#include <numeric>
 
 #include "framework/cli/commands.hpp"
 #include "framework/core/atomic_file.hpp"
@@ -140,7 +139,14 @@ int run_dataset_info(const std::string& file, const std::string& figures) {
   const data::Dataset d = data::read_dataset(file);
   std::cout << fmt::format("{}: format_version {}, skinlab {}\n", file, data::kFormatVersion,
                            d.git_commit);
-  std::cout << fmt::format("characters: {}\n", d.characters.size());
+  std::vector<int> originals;  // every character but the augmented copies (data/augment.hpp)
+  for (std::size_t i = 0; i < d.characters.size(); ++i) {
+    if (!d.characters[i].is_augmented_copy()) originals.push_back(static_cast<int>(i));
+  }
+  const std::size_t copies = d.characters.size() - originals.size();
+  std::cout << fmt::format(
+      "characters: {}{}\n", d.characters.size(),
+      copies > 0 ? fmt::format(" ({} of them augmented training copies)", copies) : std::string());
   for (const auto& c : d.characters) {
     std::string distances;
     for (const auto& [type, dd] : c.distances) {
@@ -154,16 +160,18 @@ int run_dataset_info(const std::string& file, const std::string& figures) {
         c.name, c.num_vertices(), c.vertex_map.size(), merged(c), c.subdivision_levels, c.F.rows(),
         c.num_joints(), c.num_bones(), c.animations.size(), distances.empty() ? "none" : distances,
         c.source, c.path, c.skeleton, c.group, c.licence.empty() ? "unknown" : c.licence);
+    if (c.is_augmented_copy()) {
+      std::cout << fmt::format("    augmented copy of {}\n", c.augmented_from);
+    }
   }
   std::cout << fmt::format("splits: {}\n", d.splits.size());
   for (const auto& [name, s] : d.splits) {
     std::cout << fmt::format("  {}: train {}, val {}, test {}\n", name, s.train.size(),
                              s.val.size(), s.test.size());
   }
-  std::vector<int> all(d.characters.size());
-  std::iota(all.begin(), all.end(), 0);
-  PartCoverage parts{{"all", coverage_of(d, all)}};
-  print_coverage(d, all, parts.back().second, "all characters");
+  PartCoverage parts{{"all", coverage_of(d, originals)}};
+  print_coverage(d, originals, parts.back().second,
+                 copies > 0 ? "all characters (augmented copies left out)" : "all characters");
   for (const auto& [name, s] : d.splits) {
     parts.emplace_back("test:" + name, coverage_of(d, s.test));
     print_coverage(d, s.test, parts.back().second, "test part of split '" + name + "'");

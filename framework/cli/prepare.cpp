@@ -58,8 +58,10 @@ int run_prepare(PrepareArgs args) {
   }
   const data::PrepareReport r = data::prepare_dataset(prepare, args.options);
   std::cout << fmt::format(
-      "prepared {}: {} characters ({} computed, {} reused), {} excluded, {:.2f} s\n",
-      r.output.string(), r.characters, r.computed, r.reused, r.excluded.size(), r.seconds);
+      "prepared {}: {} characters ({}{} computed, {} reused), {} excluded, {:.2f} s\n",
+      r.output.string(), r.characters,
+      r.copies > 0 ? fmt::format("{} of them augmented copies; ", r.copies) : std::string(),
+      r.computed, r.reused, r.excluded.size(), r.seconds);
   for (const auto& e : r.excluded) {
     std::cout << fmt::format("  excluded {}:{}: {}\n", e.source, e.path, e.reason);
   }

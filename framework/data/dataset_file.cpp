@@ -60,6 +60,7 @@ void write_character(H5Writer& w, const PreparedCharacter& c) {
   w.write_attribute(g, "attribution", c.attribution);
   w.write_attribute(g, "skeleton", c.skeleton);
   w.write_attribute(g, "group", c.group.empty() ? c.name : c.group);
+  if (c.is_augmented_copy()) w.write_attribute(g, "augmented_from", c.augmented_from);
   w.write_attribute(g, "subdivision_levels", static_cast<std::int64_t>(c.subdivision_levels));
   w.create_group(g + "/animations");
   for (std::size_t a = 0; a < c.animations.size(); ++a) {
@@ -233,6 +234,9 @@ PreparedCharacter read_character(const H5Reader& r, const std::string& name) {
   c.attribution = r.read_attribute(g, "attribution");
   c.skeleton = r.read_attribute(g, "skeleton");
   c.group = r.has_attribute(g, "group") ? r.read_attribute(g, "group") : c.name;
+  if (r.has_attribute(g, "augmented_from")) {
+    c.augmented_from = r.read_attribute(g, "augmented_from");
+  }
   c.subdivision_levels = static_cast<int>(r.read_int_attribute(g, "subdivision_levels"));
 
   const std::string animations = g + "/animations";

@@ -74,7 +74,9 @@ struct PreparedCharacter {
   /// #V_orig: the vertex of V that every vertex of the source mesh became (merge map; the first
   /// vertices of V are the merged originals, subdivision only appends).
   std::vector<int> vertex_map;
-  /// 4×4 similarity [s·R, t; 0 0 0 1] from the source file's frame to the normalised frame.
+  /// 4×4 similarity [s·R, t; 0 0 0 1] from the source file's frame to the normalised frame. For
+  /// an augmented copy, the original's similarity followed by the copy's own normalisation; the
+  /// copy is a deformation of the source, not its image under this map.
   Eigen::Matrix4d normalisation = Eigen::Matrix4d::Identity();
   int subdivision_levels = 0;
   /// Per distance registry key (e.g. "hollow_dist").
@@ -89,8 +91,12 @@ struct PreparedCharacter {
   /// Variant group (clean.hpp): splits never divide a group. Empty means the character alone
   /// (written as its own name).
   std::string group;
+  /// For an augmented training copy (augment.hpp, named "<original>~aug<i>"): the name of the
+  /// character it was made from; empty for every other character.
+  std::string augmented_from;
   std::vector<AnimationData> animations;
 
+  bool is_augmented_copy() const { return !augmented_from.empty(); }
   int num_vertices() const { return static_cast<int>(V.rows()); }
   int num_joints() const { return static_cast<int>(joint_names.size()); }
   int num_bones() const { return static_cast<int>(bones.rows()); }

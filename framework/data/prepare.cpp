@@ -1,5 +1,6 @@
 #include "framework/data/prepare.hpp"
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -82,6 +83,47 @@ std::optional<PreparedCharacter> reusable(const fs::path& file, const std::strin
   }
 }
 
+/// One character to preprocess: characters[source] itself (copy -1) or its augmented copy.
+struct Job {
+  std::size_t source = 0;
+  int copy = -1;
+  std::string name;  ///< the prepared character's name (and its partial file's stem)
+};
+
+struct JobResult {
+  bool reused = false;
+  std::optional<std::string> failure;
+};
+
+void add_copies(std::vector<Job>& jobs, std::size_t source, const std::string& name, int copies) {
+  for (int c = 0; c < copies; ++c) jobs.push_back({source, c, augmented_name(name, c)});
+}
+
+/// Per character index: whether the train part of some split holds it.
+std::vector<bool> trained_in_some_split(const std::map<std::string, Split>& splits,
+                                        std::size_t count) {
+  std::vector<bool> out(count, false);
+  for (const auto& [name, split] : splits) {
+    for (int i : split.train) out.at(static_cast<std::size_t>(i)) = true;
+  }
+  return out;
+}
+
+/// Throws when a copy's name would be a source character's name.
+void check_copy_names(const std::vector<datasets::SourceCharacter>& characters, int copies) {
+  std::set<std::string> names;
+  for (const auto& c : characters) names.insert(c.character.name);
+  for (const auto& c : characters) {
+    for (int k = 0; k < copies; ++k) {
+      const std::string copy = augmented_name(c.character.name, k);
+      if (names.count(copy)) {
+        throw Error("preprocess.augment: the copy '" + copy + "' of '" + c.character.name +
+                    "' would have the name of a source character");
+      }
+    }
+  }
+}
+
 }  // namespace
 
 PrepareConfig PrepareConfig::from(const config::Config& config) {
@@ -153,52 +195,95 @@ PrepareReport prepare_dataset(const PrepareConfig& config, const PrepareOptions&
     return !sharded || i % static_cast<std::size_t>(options.shard_count) ==
                            static_cast<std::size_t>(options.shard_index);
   };
-  std::vector<std::optional<std::string>> failure(n);
-  std::vector<char> reused(n, 0);
-  std::mutex mutex;
-  std::optional<Progress> progress;
-  std::size_t share = 0;
-  for (std::size_t i = 0; i < n; ++i) share += mine(i) ? 1 : 0;
-  if (options.progress) progress.emplace("prepare", share);
+  const int copies = config.preprocess.augment.copies;
+  if (copies > 0) check_copy_names(characters, copies);
 
-  auto work = [&](std::size_t i) {
-    if (!mine(i)) return;
-    const auto& source = characters[i];
-    const std::string& name = source.character.name;
-    const fs::path file = partial / (name + ".h5");
-    try {
-      if (reusable(file, name, config.preparation)) {
-        reused[i] = 1;
-      } else {
-        Dataset one;
-        one.git_commit = commit;
-        one.preparation = config.preparation;
-        one.characters.push_back(preprocess(source, distances, config.preprocess));
-        write_dataset(file, one, 0);  // uncompressed: HDF5's global lock would serialise deflate
+  // Preprocesses `jobs` into their partial files (or finds them done), in parallel.
+  const auto run = [&](const std::vector<Job>& jobs, const std::string& label) {
+    std::vector<JobResult> results(jobs.size());
+    std::mutex mutex;
+    std::optional<Progress> progress;
+    if (options.progress && !jobs.empty()) progress.emplace(label, jobs.size());
+    auto work = [&](std::size_t k) {
+      const Job& job = jobs[k];
+      const auto& source = characters[job.source];
+      const fs::path file = partial / (job.name + ".h5");
+      try {
+        if (reusable(file, job.name, config.preparation)) {
+          results[k].reused = true;
+        } else {
+          PreprocessMode mode;
+          mode.augment_copy = job.copy;
+          Dataset one;
+          one.git_commit = commit;
+          one.preparation = config.preparation;
+          one.characters.push_back(preprocess(source, distances, config.preprocess, mode));
+          write_dataset(file, one, 0);  // uncompressed: HDF5's global lock would serialise deflate
+        }
+      } catch (const std::exception& e) {
+        const std::string what = e.what();
+        results[k].failure =
+            what.find(job.name) == std::string::npos ? job.name + ": " + what : what;
       }
-    } catch (const std::exception& e) {
-      const std::string what = e.what();
-      failure[i] = what.find(name) == std::string::npos ? name + ": " + what : what;
-    }
-    std::lock_guard<std::mutex> lock(mutex);
-    if (progress) progress->tick();
+      std::lock_guard<std::mutex> lock(mutex);
+      if (progress) progress->tick();
+    };
+    arena.execute(
+        [&] { tbb::parallel_for(std::size_t{0}, jobs.size(), [&](std::size_t k) { work(k); }); });
+    if (progress) progress->finish();
+    return results;
   };
-  arena.execute([&] { tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) { work(i); }); });
-  if (progress) progress->finish();
+  // Counts a finished job in the report, or excludes it with its reason.
+  const auto tally = [&](const Job& job, const JobResult& result,
+                         std::vector<datasets::Excluded>& excluded) {
+    if (result.failure) {
+      excluded.push_back({characters[job.source].source, characters[job.source].path,
+                          *result.failure});
+      if (!sharded) spdlog::warn("excluded {}", *result.failure);
+      return false;
+    }
+    (result.reused ? report.reused : report.computed) += 1;
+    return true;
+  };
+
+  std::vector<Job> originals;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (mine(i)) originals.push_back({i, -1, characters[i].character.name});
+  }
+  const std::vector<JobResult> done = run(originals, "prepare");
+
   if (sharded) {
-    for (std::size_t i = 0; i < n; ++i) {
-      if (!mine(i)) continue;
-      if (failure[i]) {
-        report.excluded.push_back({characters[i].source, characters[i].path, *failure[i]});
-      } else {
-        (reused[i] ? report.reused : report.computed) += 1;
+    // The copies of this shard's characters that train in the splits as they will be if every
+    // character prepares (the merge computes the exact splits and any copy still missing).
+    std::vector<Job> augmented;
+    if (copies > 0) {
+      std::vector<std::string> skeleton, source;
+      for (const auto& c : characters) {
+        skeleton.push_back(c.skeleton);
+        source.push_back(c.source);
       }
+      const std::vector<bool> trained = trained_in_some_split(
+          make_splits(groups, skeleton, source, config.splits), characters.size());
+      for (std::size_t k = 0; k < originals.size(); ++k) {
+        if (!done[k].failure && trained[originals[k].source]) {
+          add_copies(augmented, originals[k].source, originals[k].name, copies);
+        }
+      }
+    }
+    const std::vector<JobResult> copied = run(augmented, "augment");
+    for (std::size_t k = 0; k < originals.size(); ++k) {
+      tally(originals[k], done[k], report.excluded);
+    }
+    for (std::size_t k = 0; k < augmented.size(); ++k) {
+      if (tally(augmented[k], copied[k], report.excluded)) report.copies += 1;
     }
     report.characters = report.computed + report.reused;
     report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    spdlog::info("shard {} of {}: {} characters into {} ({} computed, {} reused), {} failed, {:.2f} s",
-                 options.shard_index, options.shard_count, report.characters, partial.string(),
-                 report.computed, report.reused, share - report.characters, report.seconds);
+    spdlog::info("shard {} of {}: {} characters ({} of them augmented copies) into {} ({} "
+                 "computed, {} reused), {} failed, {:.2f} s",
+                 options.shard_index, options.shard_count, report.characters, report.copies,
+                 partial.string(), report.computed, report.reused,
+                 originals.size() + augmented.size() - report.characters, report.seconds);
     return report;
   }
 
@@ -206,16 +291,14 @@ PrepareReport prepare_dataset(const PrepareConfig& config, const PrepareOptions&
   dataset.git_commit = commit;
   dataset.preparation = config.preparation;
   dataset.excluded = report.excluded;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (failure[i]) {
-      dataset.excluded.push_back({characters[i].source, characters[i].path, *failure[i]});
-      spdlog::warn("excluded {}", *failure[i]);
-      continue;
-    }
-    Dataset one = read_dataset(partial / (characters[i].character.name + ".h5"));
+  std::vector<std::size_t> source_of;  // dataset index → index into `characters`
+  for (std::size_t k = 0; k < originals.size(); ++k) {
+    if (!tally(originals[k], done[k], dataset.excluded)) continue;
+    const std::size_t i = originals[k].source;
+    Dataset one = read_dataset(partial / (originals[k].name + ".h5"));
     dataset.characters.push_back(std::move(one.characters.at(0)));
     dataset.characters.back().group = groups[i];
-    (reused[i] ? report.reused : report.computed) += 1;
+    source_of.push_back(i);
   }
   {
     std::vector<std::string> group, skeleton, source;
@@ -225,10 +308,42 @@ PrepareReport prepare_dataset(const PrepareConfig& config, const PrepareOptions&
       source.push_back(c.source);
     }
     dataset.splits = make_splits(group, skeleton, source, config.splits);
-    for (const auto& [name, split] : dataset.splits) {
-      spdlog::info("split {}: {} train, {} val, {} test", name, split.train.size(),
-                   split.val.size(), split.test.size());
+  }
+  if (copies > 0) {
+    // Copies of the characters some split trains on, after every original (whose indices, and
+    // so the splits, stay those of the file without augmentation); each joins the train part of
+    // every split that trains on its original, and no val or test part.
+    const std::vector<bool> trained =
+        trained_in_some_split(dataset.splits, dataset.characters.size());
+    std::vector<Job> augmented;
+    std::vector<int> original_of;  // per job: the original's dataset index
+    for (std::size_t d = 0; d < trained.size(); ++d) {
+      if (!trained[d]) continue;
+      add_copies(augmented, source_of[d], dataset.characters[d].name, copies);
+      original_of.resize(augmented.size(), static_cast<int>(d));
     }
+    const std::vector<JobResult> copied = run(augmented, "augment");
+    std::vector<std::pair<int, int>> joined;  // (original, copy) dataset indices
+    for (std::size_t k = 0; k < augmented.size(); ++k) {
+      if (!tally(augmented[k], copied[k], dataset.excluded)) continue;
+      Dataset one = read_dataset(partial / (augmented[k].name + ".h5"));
+      const int original = original_of[k];
+      const std::string group = dataset.characters[static_cast<std::size_t>(original)].group;
+      dataset.characters.push_back(std::move(one.characters.at(0)));
+      dataset.characters.back().group = group;
+      joined.emplace_back(original, static_cast<int>(dataset.characters.size()) - 1);
+      report.copies += 1;
+    }
+    for (auto& [name, split] : dataset.splits) {
+      const std::set<int> train(split.train.begin(), split.train.end());
+      for (const auto& [original, copy] : joined) {
+        if (train.count(original)) split.train.push_back(copy);  // copies come last: still sorted
+      }
+    }
+  }
+  for (const auto& [name, split] : dataset.splits) {
+    spdlog::info("split {}: {} train, {} val, {} test", name, split.train.size(), split.val.size(),
+                 split.test.size());
   }
   write_dataset(config.output, dataset);
   report.characters = dataset.characters.size();
@@ -238,9 +353,11 @@ PrepareReport prepare_dataset(const PrepareConfig& config, const PrepareOptions&
     fs::remove_all(partial, ec);
   }
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  spdlog::info("prepared {}: {} characters ({} computed, {} reused), {} excluded, {:.2f} s",
-               config.output.string(), report.characters, report.computed, report.reused,
-               report.excluded.size(), report.seconds);
+  spdlog::info("prepared {}: {} characters ({}{} computed, {} reused), {} excluded, {:.2f} s",
+               config.output.string(), report.characters,
+               report.copies > 0 ? fmt::format("{} of them augmented copies; ", report.copies)
+                                 : std::string(),
+               report.computed, report.reused, report.excluded.size(), report.seconds);
   return report;
 }
 

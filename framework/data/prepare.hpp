@@ -15,7 +15,18 @@
 ///     output: results/datasets/name.h5
 ///
 /// Order: builders → cleaning (drops and variant groups) → preprocessing of each kept
-/// character → splits over the characters that preprocessed successfully → one file.
+/// character → splits over the characters that preprocessed successfully → augmented copies
+/// (`preprocess.augment`, augment.hpp) → one file.
+///
+/// Augmented copies are for training only. With `preprocess.augment.copies: N`, every character
+/// that the train part of at least one split holds gets N copies ("<name>~aug<i>", attribute
+/// `augmented_from`), preprocessed like any character after their deformation. They come after
+/// every original in the file, so the originals' indices and splits are those of the same
+/// config without augmentation; a copy joins the train part of every split whose train part
+/// holds its original and never a val or test part, and a character some split tests or
+/// validates on has no copy in the train part of that split (splits never divide a variant
+/// group, so no geometry of a test group reaches training). A copy that fails is excluded with
+/// its reason, as a character is.
 ///
 /// Resumability. Each character is preprocessed into `<output>.partial/<name>.h5` (a dataset file
 /// holding that one character), written through a temporary file and renamed into place, so a
@@ -61,6 +72,8 @@ struct PrepareOptions {
   /// Sharded preparation (`skinlab prepare --nproc N`): with shard_count > 1 this process only
   /// preprocesses the characters i with i mod shard_count = shard_index (in the cleaned order,
   /// which every process computes alike) into `<output>.partial/`, and writes no output file.
+  /// With augmentation it also makes the copies of its characters that train in the splits
+  /// over every cleaned character (the merge computes the final splits and any copy missing).
   /// A run with shard_count 1 afterwards merges them: every partial file is reused, and only
   /// what no shard finished (a character that failed is tried again) is computed.
   int shard_index = 0;
@@ -70,6 +83,7 @@ struct PrepareOptions {
 struct PrepareReport {
   std::filesystem::path output;
   std::size_t characters = 0;                ///< characters in the output file
+  std::size_t copies = 0;                    ///< of them, augmented copies (augment.hpp)
   std::size_t computed = 0;                  ///< preprocessed in this run
   std::size_t reused = 0;                    ///< taken from an existing partial file
   std::vector<datasets::Excluded> excluded;  ///< by builders and by preprocessing

@@ -30,6 +30,7 @@ PreprocessOptions PreprocessOptions::from(const config::Node& node) {
   o.leaf_bones = distances::LeafBoneOptions::from(f.section("leaf_bones"));
   f.optional("drop_weightless_leaves", o.drop_weightless_leaves);
   f.optional("drop_seed", o.drop_seed);
+  o.augment = AugmentOptions::from(f.section("augment"));
   f.check(o.merge_tolerance >= 0, "merge_tolerance", "must be ≥ 0");
   f.check(o.min_vertices >= 0, "min_vertices", "must be ≥ 0");
   f.check(o.max_vertices >= o.min_vertices, "max_vertices", "must be ≥ min_vertices");
@@ -186,20 +187,30 @@ PreparedCharacter preprocess(const datasets::SourceCharacter& source,
                : geometry::SparseWeights();
 
   // 3. Subdivide small meshes; interpolate weights linearly.
-  const geometry::SubdividedMesh sub =
+  geometry::SubdividedMesh sub =
       geometry::subdivide(merged.mesh, {options.min_vertices, options.max_vertices});
   geometry::SparseWeights W;
   if (weighted) {
     W = (sub.S * W_merged).pruned();
     W.makeCompressed();
   }
-  const geometry::Mesh& mesh = sub.mesh;
+  geometry::Mesh& mesh = sub.mesh;
   // 3b. Leaf bones on the final mesh (subdivision does not move the surface).
   distances::place_leaf_bones(mesh, c.skeleton, options.leaf_bones, where);
-  lap(times != nullptr ? &times->normalise : nullptr);
-
+  // 3c. An augmented copy: the original's geometry, skeleton and leaf tips moved together.
+  geometry::Similarity frame = sim;
   PreparedCharacter out;
   out.name = c.name;
+  if (mode.augment_copy >= 0) {
+    if (!weighted) throw Error(where + ": an augmented copy needs skin weights");
+    out.name = augmented_name(c.name, mode.augment_copy);
+    out.augmented_from = c.name;
+    const Augmentation a = draw_augmentation(options.augment, c.name, mode.augment_copy,
+                                             c.skeleton, *clips, sim.matrix());
+    frame = augment(a, W, mesh, c.skeleton, out.name).after(sim);
+  }
+  lap(times != nullptr ? &times->normalise : nullptr);
+
   out.V = mesh.V;
   out.F = mesh.F;
   out.joint_names = c.skeleton.names;
@@ -212,7 +223,7 @@ PreparedCharacter preprocess(const datasets::SourceCharacter& source,
   out.weights = W;
   out.vertex_map.assign(merged.old_to_new.data(),
                         merged.old_to_new.data() + merged.old_to_new.size());
-  out.normalisation = sim.matrix();
+  out.normalisation = frame.matrix();
   out.subdivision_levels = sub.levels;
 
   // 4. Distances, top-K candidates and bone-level targets.
@@ -268,8 +279,10 @@ PreparedCharacter preprocess(const datasets::SourceCharacter& source,
   out.licence = source.licence;
   out.attribution = source.attribution;
   out.skeleton = source.skeleton;
-  for (const auto& a : *clips) {
-    out.animations.push_back(convert(a, sim.matrix(), c.skeleton.num_joints(), where));
+  if (mode.augment_copy < 0) {
+    for (const auto& a : *clips) {
+      out.animations.push_back(convert(a, sim.matrix(), c.skeleton.num_joints(), where));
+    }
   }
   return out;
 }

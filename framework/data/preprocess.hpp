@@ -14,6 +14,8 @@
 ///    sum to 1 because the rows of S do);
 /// 3b. place the leaf joints' bones (`leaf_bones`: the paper's zero-length helpers, or bones
 ///    with extent, distances/leaf_bones.hpp), so every distance sees the same bone geometry;
+/// 3c. only for an augmented copy (PreprocessMode::augment_copy): re-pose, scale and mirror the
+///    mesh, joints and leaf tips and normalise again (augment.hpp);
 /// 4. per distance type of the config: D (#V×#B), the top-K candidate bones per vertex (K = 3,
 ///    Sec. 3.2) with their distances, and bone-level targets over the K candidates;
 /// 5. one-ring edges (Eq. 2, N_m), geodesic neighbour edges (radius 0.06, at most 10; N_g) and
@@ -35,6 +37,7 @@
 
 #include "framework/data/source.hpp"
 #include "framework/core/config.hpp"
+#include "framework/data/augment.hpp"
 #include "framework/data/dataset_file.hpp"
 #include "framework/distances/distance.hpp"
 #include "framework/distances/leaf_bones.hpp"
@@ -58,6 +61,9 @@ struct PreprocessOptions {
   /// predict for) are never changed. 0: off (the paper).
   double drop_weightless_leaves = 0.0;
   std::int64_t drop_seed = 0;
+  /// Augmented training copies (augment.hpp; `copies: 0`, the default, is off). Made by
+  /// `skinlab prepare` for the characters some split trains on (prepare.hpp).
+  AugmentOptions augment;
 
   /// Decodes a `preprocess:` map (every field optional); errors name the file, line and key.
   static PreprocessOptions from(const config::Node& node);
@@ -84,6 +90,10 @@ struct PreprocessMode {
   /// character to predict for; true: one without weights is an error (a training character).
   bool require_weights = true;
   bool laplacian = true;  ///< step 5's Laplacian (only the smoothing loss needs it)
+  /// ≥ 0: prepare copy `augment_copy` of the character (step 3c, `options.augment`), named
+  /// augmented_name(name, augment_copy), with `augmented_from` set and no clips; -1: the
+  /// character itself.
+  int augment_copy = -1;
 };
 
 /// Wall-clock seconds of the steps of one `preprocess` call.

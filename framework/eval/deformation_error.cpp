@@ -4,20 +4,12 @@
 #include <random>
 
 #include "framework/core/registry.hpp"
+#include "framework/core/stable_random.hpp"
 #include "framework/eval/value_display.hpp"
 #include "framework/eval/weights.hpp"
 #include "framework/geometry/lbs.hpp"
 
 namespace skinlab::eval {
-
-std::uint64_t stable_hash(const std::string& text) {
-  std::uint64_t h = 0xcbf29ce484222325ull;  // FNV offset basis
-  for (const unsigned char c : text) {
-    h ^= c;
-    h *= 0x100000001b3ull;  // FNV prime
-  }
-  return h;
-}
 
 DeformationError::Options DeformationError::Options::from(const config::Node& node) {
   Options o;
@@ -48,12 +40,7 @@ geometry::Skeleton skeleton_of(const data::PreparedCharacter& c) {
 
 std::vector<std::vector<Eigen::Matrix3d>> DeformationError::poses(
     const data::PreparedCharacter& character) const {
-  const std::uint64_t h = stable_hash(character.name);
-  const auto s = static_cast<std::uint64_t>(options_.seed);
-  // seed_seq's mixing and mt19937 are specified exactly by the standard.
-  std::seed_seq sequence{static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(s >> 32),
-                         static_cast<std::uint32_t>(h), static_cast<std::uint32_t>(h >> 32)};
-  std::mt19937 rng(sequence);
+  std::mt19937 rng = keyed_engine(options_.seed, character.name);
   const geometry::Skeleton skeleton = skeleton_of(character);
   std::vector<std::vector<Eigen::Matrix3d>> out;
   for (int p = 0; p < options_.poses; ++p) {

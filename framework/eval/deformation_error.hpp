@@ -25,6 +25,7 @@
 #include <cstdint>
 
 #include "framework/core/config.hpp"
+#include "framework/core/stable_random.hpp"
 #include "framework/eval/metric.hpp"
 
 namespace skinlab::eval {
@@ -60,8 +61,7 @@ class DeformationError final : public Metric {
   Options options_;
 };
 
-/// 64-bit FNV-1a hash of `text`: its value is fixed by its definition (std::hash's is not), so
-/// pose seeds are the same everywhere.
-std::uint64_t stable_hash(const std::string& text);
+/// 64-bit FNV-1a hash (core/stable_random.hpp), also reachable here where the poses use it.
+using skinlab::stable_hash;
 
 }  // namespace skinlab::eval

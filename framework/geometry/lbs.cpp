@@ -4,6 +4,8 @@
 #include <cmath>
 #include <string>
 
+#include "framework/core/stable_random.hpp"
+
 namespace skinlab::geometry {
 
 void check_skinning_inputs(const char* who, const Eigen::MatrixXd& V, const SparseWeights& W,
@@ -57,21 +59,6 @@ std::vector<Eigen::Affine3d> forward_kinematics(const Skeleton& skeleton,
   }
   return T;
 }
-
-namespace {
-
-/// Uniform on the open interval (0, 1) from one 32-bit draw.
-double uniform_open(std::mt19937& rng) {
-  return (static_cast<double>(rng()) + 0.5) * 0x1p-32;
-}
-
-/// Standard normal by Box–Muller (the cosine branch only), from two draws.
-double standard_normal(std::mt19937& rng) {
-  const double u1 = uniform_open(rng), u2 = uniform_open(rng);
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
-}
-
-}  // namespace
 
 std::vector<Eigen::Matrix3d> random_pose(const Skeleton& skeleton, std::mt19937& rng,
                                          double fraction, double sigma_degrees) {

@@ -64,6 +64,7 @@ std::vector<Figure> figures(const data::Dataset& d) {
       "bones.png", "Bones per character (RigNet order, with a helper bone per leaf joint)", {}};
   Figure joints{"joints.png", "Joints per character", {}};
   for (const auto& c : d.characters) {
+    if (c.is_augmented_copy()) continue;
     prepared.values.push_back(c.num_vertices());
     source.values.push_back(source_vertices(c));
     bones.values.push_back(c.num_bones());
@@ -94,9 +95,17 @@ std::string dataset_card_markdown(const data::Dataset& d, const fs::path& datase
   line();
 
   // ---- counts per source
+  // Augmented training copies (data/augment.hpp) are counted once, below the table, and in no
+  // table: every table describes the dataset's own characters.
   std::map<std::string, std::vector<int>> by_source;
-  for (std::size_t i = 0; i < d.characters.size(); ++i)
+  std::size_t copies = 0;
+  for (std::size_t i = 0; i < d.characters.size(); ++i) {
+    if (d.characters[i].is_augmented_copy()) {
+      ++copies;
+      continue;
+    }
     by_source[d.characters[i].source].push_back(static_cast<int>(i));
+  }
   std::map<std::string, int> excluded_by_source;
   for (const auto& e : d.excluded) excluded_by_source[e.source]++;
   std::set<std::string> sources;
@@ -118,9 +127,17 @@ std::string dataset_card_markdown(const data::Dataset& d, const fs::path& datase
     line(fmt::format("| {} | {} | {} | {} | {} |", s, by_source[s].size(), families.size(),
                      groups.size(), excluded_by_source[s]));
   }
-  line(fmt::format("| **all** | **{}** | **{}** | **{}** | **{}** |", d.characters.size(),
+  line(fmt::format("| **all** | **{}** | **{}** | **{}** | **{}** |", d.characters.size() - copies,
                    all_families.size(), all_groups.size(), d.excluded.size()));
   line();
+  if (copies > 0) {
+    line(fmt::format(
+        "The file also holds {} augmented copies (`preprocess.augment`, "
+        "`framework/data/augment.hpp`): re-posed, scaled or mirrored characters named "
+        "`<original>~aug<i>`, only in train parts. They are left out of every table below.",
+        copies));
+    line();
+  }
 
   // ---- splits
   line("## Splits");
@@ -144,8 +161,8 @@ std::string dataset_card_markdown(const data::Dataset& d, const fs::path& datase
         int k = 0;
         for (const auto* list : {&split.train, &split.val, &split.test}) {
           for (int i : *list) {
-            if (source.empty() || d.characters[static_cast<std::size_t>(i)].source == source)
-              ++n[k];
+            const auto& c = d.characters[static_cast<std::size_t>(i)];
+            if (!c.is_augmented_copy() && (source.empty() || c.source == source)) ++n[k];
           }
           ++k;
         }
@@ -185,8 +202,10 @@ std::string dataset_card_markdown(const data::Dataset& d, const fs::path& datase
   line("| family | characters | variant groups | sources | joints | bones |");
   line("|---|---:|---:|---|---:|---:|");
   std::map<std::string, std::vector<int>> by_family;
-  for (std::size_t i = 0; i < d.characters.size(); ++i)
-    by_family[d.characters[i].skeleton].push_back(static_cast<int>(i));
+  for (std::size_t i = 0; i < d.characters.size(); ++i) {
+    if (!d.characters[i].is_augmented_copy())
+      by_family[d.characters[i].skeleton].push_back(static_cast<int>(i));
+  }
   for (const auto& [family, members] : by_family) {
     std::set<std::string> groups, fam_sources;
     std::set<int> joints, bones;
@@ -219,6 +238,7 @@ std::string dataset_card_markdown(const data::Dataset& d, const fs::path& datase
   line(rule + "---|");
   for (std::size_t i = 0; i < d.characters.size(); ++i) {
     const auto& c = d.characters[i];
+    if (c.is_augmented_copy()) continue;
     std::string row =
         fmt::format("| {} | {} | {} | {} | {} | {} → {} | {} | {} | {} |", i, cell(c.name),
                     c.source, cell(c.skeleton), cell(group_of(c)), source_vertices(c),
@@ -248,7 +268,9 @@ std::string dataset_card_markdown(const data::Dataset& d, const fs::path& datase
   line("| source | licence | characters | attribution |");
   line("|---|---|---:|---|");
   std::map<std::tuple<std::string, std::string, std::string>, int> licences;
-  for (const auto& c : d.characters) licences[{c.source, c.licence, c.attribution}]++;
+  for (const auto& c : d.characters) {
+    if (!c.is_augmented_copy()) licences[{c.source, c.licence, c.attribution}]++;
+  }
   for (const auto& [key, n] : licences) {
     const auto& [source, licence, attribution] = key;
     line(fmt::format("| {} | {} | {} | {} |", source, cell(licence.empty() ? "unknown" : licence),

@@ -1,6 +1,8 @@
 #pragma once
 // Shared by the data tests: the real Minetest player (minetest-data, CC BY-SA 3.0) through the
-// `folder` builder, and a small hand-made PreparedCharacter.
+// `folder` builder, a small hand-made PreparedCharacter, and a field-by-field comparison of two.
+
+#include <gtest/gtest.h>
 
 #include <string>
 
@@ -82,6 +84,49 @@ inline data::PreparedCharacter tiny_character(const std::string& name) {
   for (int i = 0; i < 3 * 12; ++i) a.bind.push_back(-0.02f * i);
   c.animations.push_back(a);
   return c;
+}
+
+/// Every field of two prepared characters equal (the weights to float32 precision, as stored).
+inline void expect_equal(const data::PreparedCharacter& a, const data::PreparedCharacter& b) {
+  EXPECT_EQ(a.name, b.name);
+  EXPECT_EQ(a.V, b.V);
+  EXPECT_EQ(a.F, b.F);
+  EXPECT_EQ(a.joint_names, b.joint_names);
+  EXPECT_EQ(a.leaf_tips, b.leaf_tips);
+  EXPECT_EQ(a.parents, b.parents);
+  EXPECT_EQ(a.joints, b.joints);
+  EXPECT_EQ(a.bones, b.bones);
+  EXPECT_TRUE(Eigen::MatrixXd(a.weights).isApprox(Eigen::MatrixXd(b.weights), 1e-7));
+  EXPECT_EQ(a.weights.nonZeros(), b.weights.nonZeros());
+  EXPECT_EQ(a.vertex_map, b.vertex_map);
+  EXPECT_EQ(a.normalisation, b.normalisation);
+  EXPECT_EQ(a.subdivision_levels, b.subdivision_levels);
+  ASSERT_EQ(a.distances.size(), b.distances.size());
+  for (const auto& [type, d] : a.distances) {
+    const auto& e = b.distances.at(type);
+    EXPECT_EQ(d.D, e.D) << type;
+    EXPECT_EQ(d.topk_index, e.topk_index);
+    EXPECT_EQ(d.topk_distance, e.topk_distance);
+    EXPECT_EQ(d.targets, e.targets);
+  }
+  EXPECT_EQ(a.one_ring_edges, b.one_ring_edges);
+  EXPECT_EQ(a.geodesic_edges, b.geodesic_edges);
+  EXPECT_EQ(a.laplacian_indices, b.laplacian_indices);
+  EXPECT_EQ(a.laplacian_values, b.laplacian_values);
+  EXPECT_EQ(a.source, b.source);
+  EXPECT_EQ(a.path, b.path);
+  EXPECT_EQ(a.licence, b.licence);
+  EXPECT_EQ(a.attribution, b.attribution);
+  EXPECT_EQ(a.skeleton, b.skeleton);
+  EXPECT_EQ(a.augmented_from, b.augmented_from);
+  ASSERT_EQ(a.animations.size(), b.animations.size());
+  for (std::size_t i = 0; i < a.animations.size(); ++i) {
+    EXPECT_EQ(a.animations[i].name, b.animations[i].name);
+    EXPECT_EQ(a.animations[i].fps, b.animations[i].fps);
+    EXPECT_EQ(a.animations[i].num_frames, b.animations[i].num_frames);
+    EXPECT_EQ(a.animations[i].frames, b.animations[i].frames);
+    EXPECT_EQ(a.animations[i].bind, b.animations[i].bind);
+  }
 }
 
 }  // namespace skinlab::testing

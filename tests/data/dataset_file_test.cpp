@@ -17,6 +17,7 @@ namespace skinlab {
 namespace {
 namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
+using testing::expect_equal;
 using testing::expect_error;
 using testing::TempDir;
 
@@ -28,53 +29,13 @@ data::Dataset tiny_dataset() {
   // beta's leaf bones have extent (format version 2); alpha keeps the paper's zero-length ones.
   d.characters[1].leaf_tips = d.characters[1].joints;
   d.characters[1].leaf_tips.bottomRows(1).array() += 0.25;
+  d.characters[1].augmented_from = "alpha";  // as an augmented copy (alpha's, say)
   d.splits["random"] = {{0}, {}, {1}};
   d.splits["by_skeleton"] = {{1}, {0}, {}};
   d.excluded = {{"folder", "bad.fbx", "bad.fbx: cannot read"}, {"zeroad", "x.pmd", "no bones"}};
   d.git_commit = "0123abcd";
   d.preparation = "preprocess: {}\ndistances: [{type: euclidean}]\n";
   return d;
-}
-
-void expect_equal(const data::PreparedCharacter& a, const data::PreparedCharacter& b) {
-  EXPECT_EQ(a.name, b.name);
-  EXPECT_EQ(a.V, b.V);
-  EXPECT_EQ(a.F, b.F);
-  EXPECT_EQ(a.joint_names, b.joint_names);
-  EXPECT_EQ(a.leaf_tips, b.leaf_tips);
-  EXPECT_EQ(a.parents, b.parents);
-  EXPECT_EQ(a.joints, b.joints);
-  EXPECT_EQ(a.bones, b.bones);
-  EXPECT_TRUE(Eigen::MatrixXd(a.weights).isApprox(Eigen::MatrixXd(b.weights), 1e-7));
-  EXPECT_EQ(a.weights.nonZeros(), b.weights.nonZeros());
-  EXPECT_EQ(a.vertex_map, b.vertex_map);
-  EXPECT_EQ(a.normalisation, b.normalisation);
-  EXPECT_EQ(a.subdivision_levels, b.subdivision_levels);
-  ASSERT_EQ(a.distances.size(), b.distances.size());
-  for (const auto& [type, d] : a.distances) {
-    const auto& e = b.distances.at(type);
-    EXPECT_EQ(d.D, e.D) << type;
-    EXPECT_EQ(d.topk_index, e.topk_index);
-    EXPECT_EQ(d.topk_distance, e.topk_distance);
-    EXPECT_EQ(d.targets, e.targets);
-  }
-  EXPECT_EQ(a.one_ring_edges, b.one_ring_edges);
-  EXPECT_EQ(a.geodesic_edges, b.geodesic_edges);
-  EXPECT_EQ(a.laplacian_indices, b.laplacian_indices);
-  EXPECT_EQ(a.laplacian_values, b.laplacian_values);
-  EXPECT_EQ(a.source, b.source);
-  EXPECT_EQ(a.path, b.path);
-  EXPECT_EQ(a.licence, b.licence);
-  EXPECT_EQ(a.attribution, b.attribution);
-  EXPECT_EQ(a.skeleton, b.skeleton);
-  ASSERT_EQ(a.animations.size(), b.animations.size());
-  for (std::size_t i = 0; i < a.animations.size(); ++i) {
-    EXPECT_EQ(a.animations[i].name, b.animations[i].name);
-    EXPECT_EQ(a.animations[i].fps, b.animations[i].fps);
-    EXPECT_EQ(a.animations[i].num_frames, b.animations[i].num_frames);
-    EXPECT_EQ(a.animations[i].frames, b.animations[i].frames);
-    EXPECT_EQ(a.animations[i].bind, b.animations[i].bind);
-  }
 }
 
 TEST(DatasetFile, RoundTrip) {

@@ -112,7 +112,7 @@ TEST(LinePlot, CurvesFollowTheirValuesAndGapsBreakThem) {
   EXPECT_THROW(line_plot({Series{{1, 2}, {1}}}), std::invalid_argument);
 }
 
-TEST(DatasetCard, ReportsCountsSplitsExclusionsAndLicences) {
+TEST(DatasetCard, ReportsCountsSplitsExclusionsAndLicencesWithoutAugmentedCopies) {
   data::Dataset d;
   d.characters = {testing::tiny_character("a"), testing::tiny_character("b"),
                   testing::tiny_character("c")};
@@ -120,7 +120,11 @@ TEST(DatasetCard, ReportsCountsSplitsExclusionsAndLicences) {
   d.characters[2].source = "other";
   d.characters[2].skeleton = "bird";
   d.characters[2].licence = "GPL-2+";
-  d.splits["random"] = {{0, 1}, {}, {2}};
+  // An augmented training copy of a (data/augment.hpp): in no table, counted once.
+  d.characters.push_back(testing::tiny_character("a~aug0"));
+  d.characters[3].augmented_from = "a";
+  d.characters[3].group = "a";
+  d.splits["random"] = {{0, 1, 3}, {}, {2}};
   d.excluded = {{"test", "dir/x.fbx", "x: rigid-only weights | one joint"}};
   testing::TempDir dir;
   DatasetCardOptions options;
@@ -135,6 +139,8 @@ TEST(DatasetCard, ReportsCountsSplitsExclusionsAndLicences) {
         "| 2 | c | other | bird | c | 5 → 4 |", "![", "card/bones.png"}) {
     EXPECT_NE(md.find(part), std::string::npos) << part << "\n" << md;
   }
+  EXPECT_NE(md.find("also holds 1 augmented copies"), std::string::npos) << md;
+  EXPECT_EQ(md.find("a~aug0"), std::string::npos) << md;
   for (const char* png : {"vertices.png", "source_vertices.png", "joints.png", "bones.png"}) {
     EXPECT_TRUE(std::filesystem::exists(dir / "card" / png)) << png;
   }
