@@ -1,9 +1,5 @@
 #include "baselines/bone_heat/bone_heat.hpp"
 
-#include <CGAL/AABB_traits.h>
-#include <CGAL/AABB_tree.h>
-#include <CGAL/AABB_triangle_primitive.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <tbb/parallel_for.h>
 
 #include <Eigen/Geometry>
@@ -18,6 +14,7 @@
 #include <vector>
 
 #include "framework/core/registry.hpp"
+#include "framework/distances/triangle_tree.hpp"
 #include "framework/geometry/closest_point_on_segment.hpp"
 #include "framework/geometry/orient_outward.hpp"
 
@@ -26,13 +23,13 @@ namespace skinlab::baselines {
 namespace {
 
 using geometry::GeometryError;
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Point = Kernel::Point_3;
-using Segment = Kernel::Segment_3;
-using Triangle = Kernel::Triangle_3;
-using TriangleIterator = std::vector<Triangle>::const_iterator;
-using Primitive = CGAL::AABB_triangle_primitive<Kernel, TriangleIterator>;
-using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>>;
+// The CGAL types of the distances' AABB tree; the tree itself is built here, since the
+// triangles kept differ from aabb::TriangleTree's (see the face filter below).
+using distances::aabb::Point;
+using distances::aabb::Segment;
+using distances::aabb::Tree;
+using distances::aabb::Triangle;
+using distances::aabb::TriangleIterator;
 
 const char* const kBoneHeatOwner = "binder 'bone_heat'";
 constexpr double kDistanceEpsilon = 1e-4;  // Blender DISTANCE_EPSILON (relative tie tolerance)
