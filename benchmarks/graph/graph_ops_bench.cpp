@@ -183,6 +183,35 @@ void BM_EdgeConvPerEdgeReference(benchmark::State& state) {
   }
 }
 
+/// HeterSkinNet's head MLP (Sec. 4.2: [1024, 512, K] on vertex local 256 ‖ K = 3 candidate bones'
+/// local 128 ‖ global 512 + 512), forward+backward as in training. Argument {split}: 1 is
+/// `Mlp::forward_gathered` (layer 0 split by weight blocks), 0 its peer, the MLP on the #V×1664
+/// concatenation, which is what training computed before.
+void BM_GatheredMlpHead(benchmark::State& state) {
+  torch::manual_seed(3);
+  const Graph& g = bench_graph();
+  const bool split = state.range(0) != 0;
+  constexpr int64_t kOwn = 256, kShared = 1024;
+  Mlp mlp(kOwn + kTopK * kBoneWidth + kShared, MlpOptions{{1024, 512, kTopK}, false, 0.0});
+  const torch::Tensor own = torch::randn({kVertices, kOwn}).requires_grad_(true);
+  const torch::Tensor table = torch::randn({kBones, kBoneWidth}).requires_grad_(true);
+  const torch::Tensor shared = torch::randn({1, kShared}).requires_grad_(true);
+  for (int iteration = -kWarmUp; iteration < 0 || state.KeepRunning(); ++iteration) {
+    torch::Tensor out;
+    if (split) {
+      out = mlp->forward_gathered(own, table, g.topk_index, shared);
+    } else {
+      out = mlp->forward(torch::cat(
+          {own, table.index_select(0, g.topk_index.reshape({-1})).view({kVertices, -1}),
+           shared.expand({kVertices, kShared})},
+          1));
+    }
+    out.sum().backward();
+    for (auto& p : mlp->parameters()) p.mutable_grad().reset();
+    for (const torch::Tensor& t : {own, table, shared}) t.mutable_grad().reset();
+  }
+}
+
 void BM_DropEdges(benchmark::State& state) {
   torch::manual_seed(2);
   const Graph& g = bench_graph();
@@ -221,6 +250,7 @@ BENCHMARK(BM_MeanConvTranspose)
     ->ArgsProduct({{9, 64}, {0, 1}})
     ->ArgNames({"width", "backward"})
     ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_GatheredMlpHead)->Arg(0)->Arg(1)->ArgName("split")->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DropEdges)->Unit(benchmark::kMicrosecond);
 
 }  // namespace

@@ -63,11 +63,7 @@ torch::Tensor MlpImpl::forward_gathered(const torch::Tensor& own, const torch::T
               "mlp: forward_gathered expects a 1×F shared row, got ", shared.sizes());
   TORCH_CHECK(f0 + k * f1 + f2 == in_width_, "mlp: forward_gathered's blocks are ", f0, " + ", k,
               "×", f1, " + ", f2, " wide, the MLP takes ", in_width_);
-  const bool grad = torch::GradMode::is_enabled() &&
-                    (own.requires_grad() || table.requires_grad() ||
-                     (shared.defined() && shared.requires_grad()) ||
-                     (!linears_.empty() && linears_[0]->weight.requires_grad()));
-  if (grad || linears_.empty()) {
+  if (linears_.empty()) {
     std::vector<torch::Tensor> parts{
         own, table.index_select(0, index.reshape({-1})).view({nv, k * f1})};
     if (shared.defined()) parts.push_back(shared.expand({nv, f2}));

@@ -45,12 +45,16 @@ class MlpImpl : public torch::nn::Module {
   /// #V×F₀ `own`, #B×F₁ `table`, #V×K int64 `index` and an optional 1×F₂ `shared` row (every
   /// row's; undefined for none): the input of b2v (Eq. 4) and of HeterSkinNet's head.
   ///
-  /// With gradients on, it forms the concatenation and calls forward, so training is unchanged.
-  /// Without them (prediction, evaluation) layer 0 is split by blocks of its weight:
+  /// Layer 0 is split by blocks of its weight:
   /// own·W₀ᵀ + Σ_k (table·W_kᵀ)[index(·,k)] + shared·W_sᵀ + b. This costs #B and 1 rows
-  /// instead of #V for the gathered and shared blocks, and needs no #V×width concatenation.
-  /// It is the same linear map, but the sums run in another order, so outputs differ from
-  /// forward by float rounding (~1e-6 relative).
+  /// instead of #V for the gathered and shared blocks, and needs no #V×width concatenation,
+  /// forward and backward: in HeterSkinNet's head (256 + 3×128 + 1024 inputs) layer 0's products
+  /// shrink about 6× and the whole head, forward and backward, runs 2.3× faster (graph_ops_bench,
+  /// BM_GatheredMlpHead: 889 → 394 ms CPU at 1 thread on 5K vertices).
+  /// It is the same linear map, but the sums run in another order, so outputs (and gradients)
+  /// differ from forward on the concatenation by float rounding (~1e-6 relative). Training runs
+  /// made before this split was used with gradients (up to commit 0f80872) formed the
+  /// concatenation.
   torch::Tensor forward_gathered(const torch::Tensor& own, const torch::Tensor& table,
                                  const torch::Tensor& index, const torch::Tensor& shared);
   /// Activation that follows layer `i` (identity for the last layer unless activate_last).

@@ -132,7 +132,7 @@ TEST(B2v, MatchesLoopReferenceInCandidateOrder) {
     const Features out = op->forward(t.features, t.graph);
     EXPECT_TRUE(torch::allclose(out.vertex, torch::stack(rows), 1e-10, 1e-12)) << options;
     EXPECT_TRUE(torch::equal(out.bone, t.features.bone));
-    // without gradients layer 0 is split by weight blocks (Mlp::forward_gathered)
+    // without gradients too (Mlp::forward_gathered splits layer 0 by weight blocks either way)
     torch::NoGradGuard no_grad;
     EXPECT_TRUE(torch::allclose(op->forward(t.features, t.graph).vertex, torch::stack(rows),
                                 1e-10, 1e-12))
@@ -160,8 +160,8 @@ TEST(Mlp, ForwardGatheredIsTheMlpOfTheConcatenation) {
     if (with_shared) parts.push_back(shared.expand({nv, 4}));
     const torch::Tensor expected = mlp->forward(torch::cat(parts, 1));
     const torch::Tensor s = with_shared ? shared : torch::Tensor();
-    // with gradients: the concatenation itself, so training is unchanged to the bit
-    EXPECT_TRUE(torch::equal(mlp->forward_gathered(own, table, index, s), expected));
+    EXPECT_TRUE(torch::allclose(mlp->forward_gathered(own, table, index, s), expected, 1e-12,
+                                1e-12));
     torch::NoGradGuard no_grad;
     EXPECT_TRUE(torch::allclose(mlp->forward_gathered(own, table, index, s), expected, 1e-12,
                                 1e-12));
@@ -170,6 +170,37 @@ TEST(Mlp, ForwardGatheredIsTheMlpOfTheConcatenation) {
   wrong->to(torch::kFloat64);
   expect_error<c10::Error>([&] { wrong->forward_gathered(own, table, index, shared); },
                            {"5 + 3×2 + 4 wide", "takes 7"});
+}
+
+// Training uses the block split too: its gradients (inputs and weights) are the concatenation's.
+TEST(Mlp, ForwardGatheredHasTheConcatenationsGradients) {
+  torch::manual_seed(4);
+  const int64_t nv = 11, nb = 5, k = 3;
+  const auto leaf = [](torch::Tensor t) { return t.requires_grad_(true); };
+  const torch::Tensor own = leaf(torch::randn({nv, 4}, torch::kFloat64));
+  const torch::Tensor table = leaf(torch::randn({nb, 3}, torch::kFloat64));
+  const torch::Tensor shared = leaf(torch::randn({1, 2}, torch::kFloat64));
+  // repeated candidates, so a table row's gradient sums over several vertices and slots
+  const torch::Tensor index = torch::randint(0, nb, {nv, k}, torch::kInt64);
+  Mlp mlp(4 + k * 3 + 2, MlpOptions{{6, 3}});
+  mlp->to(torch::kFloat64);
+  const torch::Tensor upstream = torch::randn({nv, 3}, torch::kFloat64);
+  const auto grads = [&](bool split) {
+    torch::Tensor out =
+        split ? mlp->forward_gathered(own, table, index, shared)
+              : mlp->forward(torch::cat({own, table.index_select(0, index.reshape({-1})).view({nv, -1}),
+                                         shared.expand({nv, 2})},
+                                        1));
+    std::vector<torch::Tensor> inputs{own, table, shared};
+    for (const auto& p : mlp->parameters()) inputs.push_back(p);
+    return torch::autograd::grad({out}, inputs, {upstream});
+  };
+  const auto split = grads(true), reference = grads(false);
+  ASSERT_EQ(split.size(), reference.size());
+  for (std::size_t i = 0; i < split.size(); ++i) {
+    EXPECT_GT(reference[i].abs().max().item<double>(), 0.0) << i;
+    EXPECT_TRUE(torch::allclose(split[i], reference[i], 1e-12, 1e-12)) << i;
+  }
 }
 
 TEST(B2v, TopkErrorsNameTheVertex) {
