@@ -70,6 +70,14 @@ torch::Tensor BranchedLayers::forward(const torch::Tensor& features, const torch
   const graph::Features x = stem_->forward(in, graph);
   const graph::Features glob = global_->forward(x, graph);
   const graph::Features loc = local_->forward(x, graph);
+  // A global branch that gives every vertex one broadcast row (global_pool without keep_input,
+  // stride 0) enters the head's layer 0 as a shared row (Mlp::forward_gathered, no candidate
+  // blocks): the same map as the concatenation, without #V copies of the row in the product.
+  if (glob.vertex.size(0) > 0 && glob.vertex.stride(0) == 0) {
+    return head_->forward_gathered(loc.vertex, torch::empty({0, 0}, loc.vertex.options()),
+                                   torch::empty({loc.vertex.size(0), 0}, torch::kInt64),
+                                   glob.vertex.narrow(0, 0, 1));
+  }
   return head_->forward(torch::cat({loc.vertex, glob.vertex}, 1));
 }
 

@@ -203,6 +203,25 @@ TEST(Mlp, ForwardGatheredHasTheConcatenationsGradients) {
   }
 }
 
+// No candidate blocks, only a shared row: how a branched network's head takes global_pool's
+// broadcast row (models/branched_model.cpp).
+TEST(Mlp, ForwardGatheredWithOnlyASharedRow) {
+  torch::manual_seed(5);
+  const int64_t nv = 7;
+  const torch::Tensor own = torch::randn({nv, 4}, torch::kFloat64).requires_grad_(true);
+  const torch::Tensor shared = torch::randn({1, 3}, torch::kFloat64).requires_grad_(true);
+  Mlp mlp(7, MlpOptions{{5, 2}});
+  mlp->to(torch::kFloat64);
+  const torch::Tensor split =
+      mlp->forward_gathered(own, torch::empty({0, 0}, torch::kFloat64),
+                            torch::empty({nv, 0}, torch::kInt64), shared);
+  const torch::Tensor reference = mlp->forward(torch::cat({own, shared.expand({nv, 3})}, 1));
+  EXPECT_TRUE(torch::allclose(split, reference, 1e-12, 1e-12));
+  const auto g1 = torch::autograd::grad({split.sum()}, {own, shared});
+  const auto g2 = torch::autograd::grad({reference.sum()}, {own, shared});
+  for (int i = 0; i < 2; ++i) EXPECT_TRUE(torch::allclose(g1[i], g2[i], 1e-12, 1e-12)) << i;
+}
+
 TEST(B2v, TopkErrorsNameTheVertex) {
   TinyGraph t = tiny_graph(3, 2);
   auto op = make_op("{type: b2v, mlp: [4]}", t.dims);
