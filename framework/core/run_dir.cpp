@@ -78,6 +78,19 @@ void RunDir::write_env(const nlohmann::json& env) const {
   write_file_atomic(file("env.json"), env.dump(2) + "\n");
 }
 
+void RunDir::record_resume(const nlohmann::json& record) const {
+  const fs::path target = file("env.json");
+  nlohmann::json env = nlohmann::json::object();
+  if (fs::exists(target)) {
+    env = nlohmann::json::parse(read_file(target), nullptr, /*allow_exceptions=*/false);
+    if (!env.is_object()) throw Error(target.string() + ": not a JSON object");
+  }
+  if (!env.contains("resumes")) env["resumes"] = nlohmann::json::array();
+  if (!env["resumes"].is_array()) throw Error(target.string() + ": 'resumes' is not a list");
+  env["resumes"].push_back(record);
+  write_env(env);
+}
+
 void RunDir::append_metrics(const nlohmann::json& record) const {
   if (!record.is_object()) throw Error(file("metrics.jsonl").string() + ": a metrics record must be a JSON object");
   const fs::path target = file("metrics.jsonl");

@@ -33,6 +33,10 @@ class RunDir {
   void write_config(const std::string& resolved_yaml) const;
   /// Writes `env.json` (atomically).
   void write_env(const nlohmann::json& env) const;
+  /// Appends `record` to the `resumes` list of `env.json` (atomically; the list is created on
+  /// the first resume). env.json describes the code a run started with; a run resumed from
+  /// last.pt by another build says so here, so every epoch stays traceable to its commit.
+  void record_resume(const nlohmann::json& record) const;
   /// Appends one record to `metrics.jsonl`. The file is rewritten atomically, so a crash leaves
   /// every line complete.
   void append_metrics(const nlohmann::json& record) const;

@@ -185,6 +185,15 @@ TEST_F(Training, ResumedRunEqualsTheUninterruptedOne) {
     expect_identical(parameters(config, straight.file(ckpt)), parameters(config, run.file(ckpt)));
   }
   EXPECT_EQ(records(straight), records(run));
+  // env.json keeps the start's record and lists the resume with the code it ran on.
+  const nlohmann::json env = nlohmann::json::parse(read_file(run.file("env.json")));
+  EXPECT_EQ(env["command"], nlohmann::json::array({"test"}));
+  ASSERT_TRUE(env.contains("resumes"));
+  ASSERT_EQ(env["resumes"].size(), 1u);
+  EXPECT_EQ(env["resumes"][0]["after_epoch"], 2);
+  EXPECT_EQ(env["resumes"][0]["git_commit"], env["git_commit"]);
+  EXPECT_TRUE(env["resumes"][0].contains("time_utc"));
+  EXPECT_FALSE(nlohmann::json::parse(read_file(straight.file("env.json"))).contains("resumes"));
 }
 
 TEST_F(Training, ResumeDropsMetricsOfAnEpochWithoutCheckpoint) {
