@@ -3,6 +3,7 @@
 /// library code; this is the only place where an exception becomes a message and an exit status.
 
 #include <CLI/CLI.hpp>
+#include <c10/util/Exception.h>
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
@@ -26,14 +27,13 @@ namespace {
 int run_info(bool as_json) {
   nlohmann::json registries = nlohmann::json::object();
   for (const auto* registry : all_registries()) registries[registry->name()] = registry->keys();
-  const GitState git = git_state(source_dir());
+  const GitState& git = build_git_state();
   if (as_json) {
-    nlohmann::json out = {{"version", SKINLAB_VERSION},
-                          {"git_commit", git.commit},
-                          {"git_dirty", git.dirty},
-                          {"libraries", library_versions()},
-                          {"threads", torch_threads()},
-                          {"registries", registries}};
+    nlohmann::json out = {{"version", SKINLAB_VERSION}};
+    out.update(git_json(git));
+    out.update({{"libraries", library_versions()},
+                {"threads", torch_threads()},
+                {"registries", registries}});
     std::cout << out.dump(2) << "\n";
     return 0;
   }
@@ -131,6 +131,10 @@ int main(int argc, char** argv) {
     for (const auto& command : commands) {
       if (command.app->parsed()) return command.run();
     }
+  } catch (const c10::Error& e) {  // a check inside the tensor code: its message, no C++ backtrace
+    std::fflush(stdout);
+    std::cerr << "skinlab: error: " << e.what_without_backtrace() << "\n";
+    return 1;
   } catch (const std::exception& e) {
     std::fflush(stdout);
     std::cerr << "skinlab: error: " << e.what() << "\n";

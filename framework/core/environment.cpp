@@ -10,10 +10,8 @@
 #include <Eigen/Core>
 #include <array>
 #include <climits>
-#include <cstdio>
 #include <ctime>
 #include <fstream>
-#include <memory>
 #include <utility>
 
 #include "framework/core/error.hpp"
@@ -32,22 +30,6 @@ namespace {
 ComputeRuntime& compute_runtime() {
   static ComputeRuntime runtime;
   return runtime;
-}
-
-/// Runs a shell command and returns its stdout, or nullopt-like empty + ok=false on failure.
-bool run_capture(const std::string& command, std::string& out) {
-  std::unique_ptr<FILE, int (*)(FILE*)> pipe(::popen(command.c_str(), "r"), ::pclose);
-  if (!pipe) return false;
-  std::array<char, 512> buffer{};
-  out.clear();
-  while (std::fgets(buffer.data(), buffer.size(), pipe.get()) != nullptr) out += buffer.data();
-  return ::pclose(pipe.release()) == 0;
-}
-
-std::string quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += (c == '\'') ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
 }
 
 /// The file a shared library with this soname was really loaded from (symlinks and Debian's
@@ -73,17 +55,13 @@ std::string loaded_library(const std::string& soname) {
 
 std::filesystem::path source_dir() { return SKINLAB_SOURCE_DIR; }
 
-GitState git_state(const std::filesystem::path& dir) {
-  GitState state;
-  std::string out;
-  const std::string git = "git -C " + quote(dir.string());
-  if (run_capture(git + " rev-parse HEAD 2>/dev/null", out) && out.size() >= 40) {
-    state.commit = out.substr(0, 40);
-    if (run_capture(git + " status --porcelain --untracked-files=no 2>/dev/null", out)) {
-      state.dirty = !out.empty();
-    }
+nlohmann::json git_json(const GitState& state) {
+  nlohmann::json out = {{"git_commit", state.commit}, {"git_dirty", state.dirty}};
+  if (state.dirty) {
+    out["git_modified"] = state.modified;
+    out["git_diff_sha256"] = state.diff_sha256;
   }
-  return state;
+  return out;
 }
 
 void register_compute_runtime(ComputeRuntime runtime) { compute_runtime() = std::move(runtime); }
@@ -121,7 +99,6 @@ double peak_memory_mib() {
 }
 
 nlohmann::json collect_environment(std::uint64_t seed, const std::vector<std::string>& command) {
-  const GitState git = git_state(source_dir());
   std::array<char, 256> host{};
   if (::gethostname(host.data(), host.size() - 1) != 0) host[0] = '\0';
   const std::time_t now = std::time(nullptr);
@@ -129,9 +106,8 @@ nlohmann::json collect_environment(std::uint64_t seed, const std::vector<std::st
   ::gmtime_r(&now, &utc);
   std::array<char, 32> time_text{};
   std::strftime(time_text.data(), time_text.size(), "%Y-%m-%dT%H:%M:%SZ", &utc);
-  return {
-      {"git_commit", git.commit},
-      {"git_dirty", git.dirty},
+  nlohmann::json env = git_json(build_git_state());
+  env.update({
       {"build_type", SKINLAB_BUILD_TYPE},
       {"libraries", library_versions()},
       {"threads", compute_runtime().threads ? compute_runtime().threads() : 1},
@@ -140,7 +116,8 @@ nlohmann::json collect_environment(std::uint64_t seed, const std::vector<std::st
       {"host", host.data()},
       {"time_utc", time_text.data()},
       {"command", command},
-  };
+  });
+  return env;
 }
 
 }  // namespace skinlab

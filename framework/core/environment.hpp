@@ -16,10 +16,19 @@ namespace skinlab {
 struct GitState {
   std::string commit = "unknown";  ///< full SHA, or "unknown" outside a work tree / without git
   bool dirty = false;              ///< tracked files modified (untracked files do not count)
+  std::vector<std::string> modified;  ///< those files (`git diff HEAD --name-only`), if dirty
+  std::string diff_sha256;         ///< SHA-256 of `git diff HEAD --binary`, if dirty
 };
 
-/// Reads the git state of `dir` by running `git` (no network).
-GitState git_state(const std::filesystem::path& dir);
+/// The git state of the source tree this binary was compiled from, recorded at build time
+/// (cmake/build_info.cmake). What env.json, the dataset file and `skinlab info` report: a binary
+/// kept running while the tree moves on (a long sweep, a copied binary) still names its own
+/// code, and a dirty build is identifiable by its modified files and diff hash.
+const GitState& build_git_state();
+
+/// {"git_commit", "git_dirty", "git_modified", "git_diff_sha256"} of `state` (the last two only
+/// when dirty), as env.json records them.
+nlohmann::json git_json(const GitState& state);
 
 /// Versions of the compiler and of every library that can change a result:
 /// {"compiler", <the compute runtime, e.g. "libtorch">, "eigen", "cgal", "hdf5", "yaml_cpp", "fmt", "spdlog", "json"}, and the

@@ -115,7 +115,7 @@ struct Dataset {
   std::vector<PreparedCharacter> characters;  ///< order of /character_names
   std::map<std::string, Split> splits;
   std::vector<datasets::Excluded> excluded;
-  std::string git_commit = "unknown";  ///< skinlab commit that wrote the file ("-dirty": modified)
+  std::string git_commit = "unknown";  ///< commit the writing skinlab was built from ("-dirty-<diff hash>": modified)
   /// The resolved `preprocess:` and `distances:` config (YAML) the characters were made with;
   /// `skinlab prepare` reuses a partial character file only when this matches.
   std::string preparation;

@@ -61,8 +61,8 @@ std::string indent(const std::string& text) {
 }
 
 std::string git_commit() {
-  const GitState git = git_state(source_dir());
-  return git.commit + (git.dirty ? "-dirty" : "");
+  const GitState& git = build_git_state();
+  return git.commit + (git.dirty ? "-dirty-" + git.diff_sha256.substr(0, 12) : "");
 }
 
 /// The character stored in a partial file, when it is complete and made with `preparation`.
