@@ -1,6 +1,7 @@
 #include "framework/geometry/weightless_leaves.hpp"
 
 #include <cmath>
+#include <string>
 #include <vector>
 
 namespace skinlab::geometry {
@@ -67,6 +68,37 @@ std::vector<int> drop_weightless_leaves(Character& character) {
   s = std::move(kept);
   character.weights = std::move(W);
   return kept_joints;
+}
+
+SparseWeights onto_kept_joints(const SparseWeights& weights, const std::vector<int>& parents,
+                               const std::vector<int>& kept) {
+  const int n = static_cast<int>(parents.size());
+  if (weights.cols() != n) {
+    throw GeometryError("onto_kept_joints: the weights have " + std::to_string(weights.cols()) +
+                        " joint columns, the skeleton " + std::to_string(n) + " joints");
+  }
+  std::vector<int> new_index(static_cast<std::size_t>(n), -1);
+  for (std::size_t k = 0; k < kept.size(); ++k) new_index[static_cast<std::size_t>(kept[k])] = static_cast<int>(k);
+  // each joint's column: its own if kept, else its nearest kept ancestor's
+  std::vector<int> target(static_cast<std::size_t>(n), -1);
+  for (int j = 0; j < n; ++j) {
+    int a = j;
+    while (a >= 0 && new_index[static_cast<std::size_t>(a)] < 0) a = parents[static_cast<std::size_t>(a)];
+    if (a < 0) {
+      throw GeometryError("onto_kept_joints: joint " + std::to_string(j) +
+                          " has no kept ancestor (the root must be kept)");
+    }
+    target[static_cast<std::size_t>(j)] = new_index[static_cast<std::size_t>(a)];
+  }
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (int v = 0; v < weights.outerSize(); ++v) {
+    for (SparseWeights::InnerIterator it(weights, v); it; ++it) {
+      triplets.emplace_back(v, target[static_cast<std::size_t>(it.col())], it.value());
+    }
+  }
+  SparseWeights out(weights.rows(), static_cast<Eigen::Index>(kept.size()));
+  out.setFromTriplets(triplets.begin(), triplets.end());  // duplicates are summed
+  return out;
 }
 
 }  // namespace skinlab::geometry

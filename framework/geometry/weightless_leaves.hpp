@@ -22,4 +22,12 @@ namespace skinlab::geometry {
 /// animation transforms.
 std::vector<int> drop_weightless_leaves(Character& character);
 
+/// Another set of weights of the same rig (#V×#J, the skeleton before the drop, whose `parents`
+/// are given) on the joints `kept` that drop_weightless_leaves returned: column kept[i] becomes
+/// column i, and the weight of a removed joint goes to its nearest kept ancestor, on whose bone
+/// the removed joint lies. Row sums are unchanged. Used to score a method that weights end joints
+/// the truth leaves empty (`skinlab score`) on the truth's bones.
+SparseWeights onto_kept_joints(const SparseWeights& weights, const std::vector<int>& parents,
+                               const std::vector<int>& kept);
+
 }  // namespace skinlab::geometry

@@ -17,6 +17,7 @@
 #include "framework/eval/evaluate.hpp"
 #include "framework/eval/predictions.hpp"
 #include "framework/eval/weights.hpp"
+#include "framework/geometry/weightless_leaves.hpp"
 #include "framework/models/model.hpp"
 #include "framework/train/checkpoint.hpp"
 #include "framework/train/trainer.hpp"
@@ -234,16 +235,29 @@ std::map<std::string, double> Predictor::score(const geometry::Character& truth,
   check_predictable(truth, options);
   data::PreprocessMode mode;
   mode.laplacian = false;
+  // The truth decides where the skeleton ends: when the preparation drops its weightless end
+  // joints (preprocess's drop_weightless_leaves), the other weights are moved onto the same kept
+  // joints, a dropped joint's weight to its nearest kept ancestor (it lies on that ancestor's
+  // bone), and both are prepared without dropping, on the same bones. Otherwise a method that
+  // weights end joints (Blender does) would be prepared with more bones than the truth.
+  geometry::Character base = truth;
+  geometry::SparseWeights others = other;
+  data::PreprocessOptions preprocess = preprocess_;
+  if (data::drops_weightless_leaves(preprocess_, truth.name)) {
+    const std::vector<int> kept = geometry::drop_weightless_leaves(base);
+    others = geometry::onto_kept_joints(other, truth.skeleton.parents, kept);
+    preprocess.drop_weightless_leaves = 0;
+  }
   auto prepare = [&](const geometry::SparseWeights& W) {
     datasets::SourceCharacter source;
-    source.character = truth;
+    source.character = base;
     source.character.weights = W;
     source.path = truth.name;
     source.up = options.up;
-    return data::preprocess(source, distances_, preprocess_, mode);
+    return data::preprocess(source, distances_, preprocess, mode);
   };
-  const data::PreparedCharacter t = prepare(truth.weights);
-  const data::PreparedCharacter o = prepare(other);
+  const data::PreparedCharacter t = prepare(base.weights);
+  const data::PreparedCharacter o = prepare(others);
   return metrics_of(data::to_tensors(o, distance()).bone_weights,
                     data::to_tensors(t, distance()).bone_weights, t);
 }

@@ -54,6 +54,28 @@ TEST(DropWeightlessLeaves, WeightlessLeafBesideWeightedOnesGoesTooButNeverTheRoo
   EXPECT_EQ(drop_weightless_leaves(single), std::vector<int>{0});
 }
 
+// Another method's weights on the end joints the truth drops go to the nearest kept ancestor.
+TEST(OntoKeptJoints, MovesWeightOfRemovedJointsToTheirNearestKeptAncestor) {
+  Character truth = rig(true);
+  const std::vector<int> parents = truth.skeleton.parents;
+  const std::vector<int> kept = drop_weightless_leaves(truth);  // root, arm, hand, head
+  SparseWeights other(3, 6);
+  other.insert(0, 4) = 0.5;  // hand_end2 -> hand
+  other.insert(0, 3) = 0.2;  // hand_end -> hand
+  other.insert(0, 1) = 0.3;  // arm stays arm
+  other.insert(1, 2) = 1.0;  // hand
+  other.insert(2, 5) = 1.0;  // head, re-indexed 5 -> 3
+  other.makeCompressed();
+  const SparseWeights mapped = onto_kept_joints(other, parents, kept);
+  ASSERT_EQ(mapped.cols(), 4);
+  EXPECT_DOUBLE_EQ(mapped.coeff(0, 2), 0.7);
+  EXPECT_DOUBLE_EQ(mapped.coeff(0, 1), 0.3);
+  EXPECT_DOUBLE_EQ(mapped.coeff(1, 2), 1.0);
+  EXPECT_DOUBLE_EQ(mapped.coeff(2, 3), 1.0);
+  EXPECT_EQ(mapped.nonZeros(), 4);
+  EXPECT_THROW(onto_kept_joints(SparseWeights(3, 5), parents, kept), GeometryError);
+}
+
 }  // namespace SKINLAB_UNITY_ID
 }  // namespace
 }  // namespace skinlab::geometry
