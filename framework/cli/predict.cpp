@@ -8,9 +8,11 @@
 ///     _rig.txt       RigNet rig text (geometry/rig_io.hpp): every kept weight
 ///     .h5            the full #V×#B bone weights and #V×#J joint weights (file comment below)
 ///
-/// Input: an OBJ with `--rig` (RigNet rig text; its `skin` lines, if any, are the ground truth),
-/// or one file assimp reads with a skeleton (FBX, glTF/GLB, DAE, IQM, B3D, ...). Weights in the
-/// input are ignored by the prediction; with `--compare-to-input` the model's metrics
+/// Input: an OBJ with `--rig` (RigNet rig text) or with a rig text next to it
+/// (geometry::rig_beside), or one file assimp reads with a skeleton (FBX, glTF/GLB, DAE, IQM,
+/// B3D, ...). Weights in the input are ignored by the prediction, so `skin` lines of a rig text
+/// that do not fit the mesh are one warning (geometry::SkinLines::ignore_mismatch); with
+/// `--compare-to-input` or `--error-map` they must be valid and the model's metrics
 /// (HeterSkinNet Sec. 4.3) against them are printed. Every output is checked before any work
 /// starts and written whole (atomic rename), so a failure never leaves a partial file.
 
@@ -87,7 +89,11 @@ int run(const PredictArgs& args) {
   // The input first: its errors are the cheap ones.
   predict::StageTimes times;
   auto start = Clock::now();
-  geometry::Character input = geometry::load_character(args.input, args.rig);
+  // Only comparing needs the input's weights whole; the prediction itself ignores them.
+  const geometry::SkinLines skin = args.compare || args.error_map
+                                       ? geometry::SkinLines::require
+                                       : geometry::SkinLines::ignore_mismatch;
+  geometry::Character input = geometry::load_character(args.input, args.rig, skin);
   try {
     predict::check_predictable(input, options);
   } catch (const Error& e) {
@@ -147,9 +153,12 @@ Command add_predict(CLI::App& app) {
       "predict", "skin weights for one character with a trained model (glTF, rig text, HDF5)");
   auto args = std::make_shared<PredictArgs>();
   cmd->add_option("input", args->input,
-                  "character file (FBX, glTF/GLB, DAE, IQM, B3D, ... or OBJ with --rig)")
+                  "character file (FBX, glTF/GLB, DAE, IQM, B3D, ... or OBJ with its rig text: "
+                  "--rig, or next to it as <stem>_rig.txt, <stem>.txt or, for RigNet's "
+                  "<id>_remesh.obj, <id>_ori_rig.txt)")
       ->required();
-  cmd->add_option("--rig", args->rig, "RigNet rig text file of an OBJ mesh (its skeleton)");
+  cmd->add_option("--rig", args->rig, "RigNet rig text file of an OBJ mesh (its skeleton; skin "
+                                      "lines that do not fit the mesh are a warning)");
   cmd->add_option("--model", args->model,
                   "run directory or bundled model (default: results/bundled/heterskinnet)");
   cmd->add_option("--checkpoint", args->checkpoint, "best or last (run directories)")
@@ -162,7 +171,7 @@ Command add_predict(CLI::App& app) {
   cmd->add_option("--max-vertices", args->max_vertices, "refuse inputs with more vertices")
       ->capture_default_str();
   cmd->add_flag("--compare-to-input", args->compare,
-                "print the metrics against the weights the input carries");
+                "print the metrics against the weights the input carries (they must be valid)");
   cmd->add_flag("--timings", args->timings, "print the time of every stage");
   cmd->add_option("--render", args->render,
                   "draw the character coloured by its most influential bone (.png)");

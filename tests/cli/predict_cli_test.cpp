@@ -1,6 +1,8 @@
 // `skinlab predict` as a user runs it: the bundled model on a real character and on a plain OBJ
 // with rig text, and the corpus of bad inputs in tests/data/bad/ (each a one-line error naming
-// the file and the element, a non-zero exit, and an existing output file left as it was).
+// the file and the element, a non-zero exit, and an existing output file left as it was);
+// and RigNet's quick-start pairs (tests/data/rignet/: remeshed OBJs with the rig texts of their
+// original meshes).
 
 #include <gtest/gtest.h>
 
@@ -26,21 +28,31 @@ using testing::run;
 using testing::TempDir;
 
 const std::string kBad = "tests/data/bad/";
+const std::string kRigNet = "tests/data/rignet/";
 const std::string kPlayer =
     "/usr/share/games/minetest/games/minetest_game/mods/player_api/models/character.b3d";
 
-/// The lines of `text` that start with "skinlab: error:".
-std::vector<std::string> error_lines(const std::string& text) {
+/// The lines of `text` that contain `marker` ("skinlab: error:" at their start when `anywhere`
+/// is false).
+std::vector<std::string> lines_with(const std::string& text, const std::string& marker,
+                                    bool anywhere) {
   std::vector<std::string> lines;
   std::size_t at = 0;
   while (at < text.size()) {
     const std::size_t end = text.find('\n', at);
     const std::string line = text.substr(at, end == std::string::npos ? std::string::npos : end - at);
-    if (line.rfind("skinlab: error:", 0) == 0) lines.push_back(line);
+    if (anywhere ? line.find(marker) != std::string::npos : line.rfind(marker, 0) == 0) {
+      lines.push_back(line);
+    }
     if (end == std::string::npos) break;
     at = end + 1;
   }
   return lines;
+}
+
+/// The lines of `text` that start with "skinlab: error:".
+std::vector<std::string> error_lines(const std::string& text) {
+  return lines_with(text, "skinlab: error:", false);
 }
 
 struct BadCase {
@@ -218,6 +230,76 @@ TEST(PredictCli, GameCharacterExportedFromItsSourceIsSkinnedAndRendered) {
   EXPECT_EQ(missing.status, 1);
   EXPECT_NE(missing.err.find("no character 'unicorn'"), std::string::npos) << missing.err;
   EXPECT_FALSE(fs::exists(dir / "u.glb"));
+}
+
+TEST(PredictCli, RigNetQuickStartPairIsPredictedWithOneWarningAboutItsSkinLines) {
+  TempDir dir;
+  // With --rig: the skin lines reference vertices beyond the 8 of the remeshed mesh.
+  const fs::path glb = dir / "17872.glb";
+  const Result r = run("predict " + kRigNet + "17872_remesh.obj --rig " + kRigNet +
+                       "17872_ori_rig.txt --out " + glb.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(glb));
+  geometry::ImportOptions o;
+  o.join_identical_vertices = false;
+  const geometry::Character skinned = geometry::import_character(glb, o);
+  EXPECT_EQ(skinned.mesh.num_vertices(), 8);
+  EXPECT_EQ(skinned.skeleton.names, (std::vector<std::string>{"root", "mid", "top"}));
+  const auto warnings = lines_with(r.err, "[warning]", true);
+  ASSERT_EQ(warnings.size(), 1u) << r.err;
+  EXPECT_NE(warnings[0].find("17872_ori_rig.txt:16: vertex 8 is out of range (the mesh has 8 "
+                             "vertices)"),
+            std::string::npos)
+      << warnings[0];
+  EXPECT_TRUE(error_lines(r.err).empty()) << r.err;
+
+  // Without --rig: the OBJ takes <id>_ori_rig.txt, which leaves vertex 6 without weight.
+  const fs::path rig = dir / "1347_rig.txt";
+  const Result beside = run("predict " + kRigNet + "1347_remesh.obj --out " + rig.string());
+  ASSERT_EQ(beside.status, 0) << beside.err;
+  EXPECT_EQ(geometry::read_rig(rig, 8).weights.rows(), 8) << "every vertex predicted";
+  const auto beside_warnings = lines_with(beside.err, "[warning]", true);
+  ASSERT_EQ(beside_warnings.size(), 1u) << beside.err;
+  EXPECT_NE(beside_warnings[0].find("1347_ori_rig.txt: vertex 6 has no weight"), std::string::npos)
+      << beside_warnings[0];
+
+  // Comparing and scoring need the skin lines: today's precise errors, nothing written.
+  const std::string pair = kRigNet + "17872_remesh.obj --rig " + kRigNet + "17872_ori_rig.txt";
+  const std::string precise = "17872_ori_rig.txt:16: vertex 8 is out of range (the mesh has 8 vertices)";
+  for (const std::string& args :
+       {"predict " + pair + " --compare-to-input --out " + (dir / "c.glb").string(),
+        "predict " + pair + " --render " + (dir / "c.png").string() + " --error-map",
+        "score " + pair + " --weights " + kRigNet + "17872_ori_rig.txt"}) {
+    const Result refused = run(args);
+    EXPECT_EQ(refused.status, 1) << args;
+    const auto lines = error_lines(refused.err);
+    ASSERT_EQ(lines.size(), 1u) << args << "\n" << refused.err;
+    EXPECT_NE(lines[0].find(precise), std::string::npos) << args << "\n" << lines[0];
+  }
+  const Result unweighted = run("predict " + kRigNet + "1347_remesh.obj --compare-to-input --out " +
+                                (dir / "u.glb").string());
+  EXPECT_EQ(unweighted.status, 1);
+  EXPECT_NE(unweighted.err.find("1347_ori_rig.txt: vertex 6 has no weight"), std::string::npos)
+      << unweighted.err;
+  EXPECT_FALSE(fs::exists(dir / "c.glb"));
+  EXPECT_FALSE(fs::exists(dir / "c.png"));
+  EXPECT_FALSE(fs::exists(dir / "u.glb"));
+
+  // A broken joint line is still an error naming the file and the line.
+  std::string text = read_file(fs::path(SKINLAB_SOURCE_DIR) / kRigNet / "17872_ori_rig.txt");
+  const std::string joint = "joints mid 0 0.5 0";
+  ASSERT_NE(text.find(joint), std::string::npos);
+  text.replace(text.find(joint), joint.size(), "joints mid 0 half 0");
+  const fs::path broken = dir / "broken_rig.txt";
+  write_file_atomic(broken, text);
+  const Result bad = run("predict " + kRigNet + "17872_remesh.obj --rig " + broken.string() +
+                         " --out " + (dir / "b.glb").string());
+  EXPECT_EQ(bad.status, 1);
+  const auto bad_lines = error_lines(bad.err);
+  ASSERT_EQ(bad_lines.size(), 1u) << bad.err;
+  EXPECT_NE(bad_lines[0].find("broken_rig.txt:4: bad coordinate 'half'"), std::string::npos)
+      << bad_lines[0];
+  EXPECT_FALSE(fs::exists(dir / "b.glb"));
 }
 
 }  // namespace SKINLAB_UNITY_ID
