@@ -129,8 +129,9 @@ Rig read_rig(const std::filesystem::path& file, int num_vertices, const WeightCh
     });
   }
   if (!ignored_skin.empty()) {
-    spdlog::warn("{}; the skin lines of {} do not fit this mesh and are ignored (skeleton only)",
-                 ignored_skin, source);
+    // The message names the file already (and the line, where there is one).
+    spdlog::warn("{}; its skin lines do not fit this mesh and are ignored (skeleton only)",
+                 ignored_skin);
     rig.ignored_skin = std::move(ignored_skin);
   }
   return rig;
