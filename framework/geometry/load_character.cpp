@@ -1,6 +1,7 @@
 #include "framework/geometry/load_character.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <string>
 
@@ -35,6 +36,13 @@ std::filesystem::path rig_beside(const std::filesystem::path& obj) {
     if (std::filesystem::is_regular_file(candidate)) return candidate;
   }
   return {};
+}
+
+bool is_character_file(const std::filesystem::path& file) {
+  static const std::array<const char*, 10> kExtensions = {
+      ".obj", ".fbx", ".glb", ".gltf", ".dae", ".b3d", ".iqm", ".smd", ".x", ".md5mesh"};
+  const std::string ext = lower_extension(file);
+  return std::find(kExtensions.begin(), kExtensions.end(), ext) != kExtensions.end();
 }
 
 Character load_character(const std::filesystem::path& file, const std::filesystem::path& rig,

@@ -30,4 +30,9 @@ std::vector<std::filesystem::path> rig_candidates(const std::filesystem::path& o
 /// The first of rig_candidates(obj) that exists; empty when none does (or `obj` is no OBJ).
 std::filesystem::path rig_beside(const std::filesystem::path& obj);
 
+/// Whether `file`'s extension is one of a character file (case-insensitive): obj, fbx, glb,
+/// gltf, dae, b3d, iqm, smd, x, md5mesh. A directory given to `skinlab predict` contributes
+/// these files; others (rig texts, textures, .blend) are not characters of their own.
+bool is_character_file(const std::filesystem::path& file);
+
 }  // namespace skinlab::geometry

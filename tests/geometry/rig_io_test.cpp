@@ -265,6 +265,10 @@ TEST(LoadCharacter, AnObjTakesTheRigTextNextToItInADocumentedOrder) {
   EXPECT_EQ(load_character(obj).skeleton.num_joints(), 3);
   EXPECT_TRUE(rig_candidates(dir / "hero.fbx").empty()) << "other formats carry their skeleton";
   EXPECT_EQ(rig_candidates(dir / "7_remesh.obj").back(), dir / "7_ori_rig.txt");
+  EXPECT_TRUE(is_character_file("a/b.GLB"));
+  EXPECT_TRUE(is_character_file("b.obj"));
+  EXPECT_FALSE(is_character_file("b_rig.txt"));
+  EXPECT_FALSE(is_character_file("b.blend"));
 }
 
 TEST(RigIo, WriterRejectsUnwritableNames) {
