@@ -1,7 +1,9 @@
 #include "framework/geometry/rig_io.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
+#include <functional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -12,7 +14,8 @@
 
 namespace skinlab::geometry {
 
-Rig read_rig(const std::filesystem::path& file, int num_vertices, const WeightCheck& check) {
+Rig read_rig(const std::filesystem::path& file, int num_vertices, const WeightCheck& check,
+             SkinLines skin) {
   const std::string text = read_file(file);
   std::vector<std::string> names;
   std::vector<double> coords;
@@ -24,11 +27,24 @@ Rig read_rig(const std::filesystem::path& file, int num_vertices, const WeightCh
   std::vector<Eigen::Triplet<double>> entries;
   std::vector<int> skin_line(num_vertices, 0);
   bool any_skin = false;
+  std::string ignored_skin;
 
   auto joint = [&](std::string_view name, const LineContext& at) {
     auto it = index.find(std::string(name));
     if (it == index.end()) at.fail("unknown joint '" + std::string(name) + "'");
     return it->second;
+  };
+  // Runs `read` over the skin lines' data; under SkinLines::ignore_mismatch its first error is
+  // kept (and the later skin lines skipped) instead of thrown.
+  auto skin_part = [&](const std::function<void()>& read) {
+    if (!ignored_skin.empty()) return;
+    try {
+      read();
+    } catch (const GeometryError& e) {
+      if (skin == SkinLines::require) throw;
+      ignored_skin = e.what();
+      entries.clear();
+    }
   };
 
   for_each_line(text, file, [&](const std::vector<std::string_view>& w, const LineContext& at) {
@@ -59,22 +75,24 @@ Rig read_rig(const std::filesystem::path& file, int num_vertices, const WeightCh
       parent_names[child] = std::string(w[1]);
       parent_line[child] = at.line;
     } else if (w[0] == "skin") {
-      if (w.size() < 4 || w.size() % 2 != 0) at.fail("expected 'skin VID JOINT WEIGHT [JOINT WEIGHT ...]'");
-      const long vid = at.number<long>(w[1], "vertex id");
-      if (vid < 0 || vid >= num_vertices) {
-        at.fail("vertex " + std::to_string(vid) + " is out of range (the mesh has " +
-                std::to_string(num_vertices) + " vertices)");
-      }
-      if (skin_line[vid] != 0) {
-        at.fail("vertex " + std::to_string(vid) + " already has weights (line " +
-                std::to_string(skin_line[vid]) + ")");
-      }
-      skin_line[vid] = at.line;
-      any_skin = true;
-      for (std::size_t k = 2; k < w.size(); k += 2) {
-        const int j = joint(w[k], at);
-        entries.emplace_back(static_cast<int>(vid), j, at.number<double>(w[k + 1], "weight"));
-      }
+      skin_part([&] {
+        if (w.size() < 4 || w.size() % 2 != 0) at.fail("expected 'skin VID JOINT WEIGHT [JOINT WEIGHT ...]'");
+        const long vid = at.number<long>(w[1], "vertex id");
+        if (vid < 0 || vid >= num_vertices) {
+          at.fail("vertex " + std::to_string(vid) + " is out of range (the mesh has " +
+                  std::to_string(num_vertices) + " vertices)");
+        }
+        if (skin_line[vid] != 0) {
+          at.fail("vertex " + std::to_string(vid) + " already has weights (line " +
+                  std::to_string(skin_line[vid]) + ")");
+        }
+        skin_line[vid] = at.line;
+        any_skin = true;
+        for (std::size_t k = 2; k < w.size(); k += 2) {
+          const int j = joint(w[k], at);
+          entries.emplace_back(static_cast<int>(vid), j, at.number<double>(w[k + 1], "weight"));
+        }
+      });
     } else {
       at.fail("unknown statement '" + std::string(w[0]) + "' (expected joints, root, hier or skin)");
     }
@@ -100,12 +118,21 @@ Rig read_rig(const std::filesystem::path& file, int num_vertices, const WeightCh
           coords.data(), static_cast<Eigen::Index>(names.size()), 3),
       parent_names, source);
   if (any_skin) {
-    rig.weights.resize(num_vertices, rig.skeleton.num_joints());
-    // Duplicate joints within one line would be summed by setFromTriplets; reject them instead.
-    rig.weights.setFromTriplets(entries.begin(), entries.end(), [&](double, double) -> double {
-      throw GeometryError(source + ": a skin line names the same joint twice");
+    skin_part([&] {
+      SparseWeights weights(num_vertices, rig.skeleton.num_joints());
+      // Duplicate joints within one line would be summed by setFromTriplets; reject them instead.
+      weights.setFromTriplets(entries.begin(), entries.end(), [&](double, double) -> double {
+        throw GeometryError(source + ": a skin line names the same joint twice");
+      });
+      check_weights(weights, num_vertices, rig.skeleton, source, check);
+      rig.weights = std::move(weights);
     });
-    check_weights(rig.weights, num_vertices, rig.skeleton, source, check);
+  }
+  if (!ignored_skin.empty()) {
+    // The message names the file already (and the line, where there is one).
+    spdlog::warn("{}; its skin lines do not fit this mesh and are ignored (skeleton only)",
+                 ignored_skin);
+    rig.ignored_skin = std::move(ignored_skin);
   }
   return rig;
 }
@@ -138,11 +165,11 @@ void write_rig(const std::filesystem::path& file, const Skeleton& skeleton,
 }
 
 Character read_obj_rig(const std::filesystem::path& obj, const std::filesystem::path& rig_file,
-                       const WeightCheck& check) {
+                       const WeightCheck& check, SkinLines skin) {
   Character character;
   character.name = obj.stem().string();
   character.mesh = read_obj(obj);
-  Rig rig = read_rig(rig_file, character.mesh.num_vertices(), check);
+  Rig rig = read_rig(rig_file, character.mesh.num_vertices(), check, skin);
   character.skeleton = std::move(rig.skeleton);
   character.weights = std::move(rig.weights);
   return character;

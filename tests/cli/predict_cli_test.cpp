@@ -1,9 +1,12 @@
 // `skinlab predict` as a user runs it: the bundled model on a real character and on a plain OBJ
 // with rig text, and the corpus of bad inputs in tests/data/bad/ (each a one-line error naming
-// the file and the element, a non-zero exit, and an existing output file left as it was).
+// the file and the element, a non-zero exit, and an existing output file left as it was);
+// RigNet's quick-start pairs (tests/data/rignet/: remeshed OBJs with the rig texts of their
+// original meshes); and many characters in one run (--out-dir: files, a directory, a list).
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -26,21 +29,47 @@ using testing::run;
 using testing::TempDir;
 
 const std::string kBad = "tests/data/bad/";
+const std::string kRigNet = "tests/data/rignet/";
 const std::string kPlayer =
     "/usr/share/games/minetest/games/minetest_game/mods/player_api/models/character.b3d";
 
-/// The lines of `text` that start with "skinlab: error:".
-std::vector<std::string> error_lines(const std::string& text) {
+/// The lines of `text` that contain `marker` ("skinlab: error:" at their start when `anywhere`
+/// is false).
+std::vector<std::string> lines_with(const std::string& text, const std::string& marker,
+                                    bool anywhere) {
   std::vector<std::string> lines;
   std::size_t at = 0;
   while (at < text.size()) {
     const std::size_t end = text.find('\n', at);
     const std::string line = text.substr(at, end == std::string::npos ? std::string::npos : end - at);
-    if (line.rfind("skinlab: error:", 0) == 0) lines.push_back(line);
+    if (anywhere ? line.find(marker) != std::string::npos : line.rfind(marker, 0) == 0) {
+      lines.push_back(line);
+    }
     if (end == std::string::npos) break;
     at = end + 1;
   }
   return lines;
+}
+
+/// The lines of `text` that start with "skinlab: error:".
+std::vector<std::string> error_lines(const std::string& text) {
+  return lines_with(text, "skinlab: error:", false);
+}
+
+/// The names of the files in `dir`, sorted.
+std::vector<std::string> files_in(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+/// The summary row of `file` in a batch's stdout ("file  status  vertices ...").
+std::string summary_row(const std::string& out, const std::string& file) {
+  for (const auto& line : lines_with(out, file, false)) {
+    if (line.size() > file.size() && line[file.size()] == ' ') return line;
+  }
+  return "";
 }
 
 struct BadCase {
@@ -218,6 +247,189 @@ TEST(PredictCli, GameCharacterExportedFromItsSourceIsSkinnedAndRendered) {
   EXPECT_EQ(missing.status, 1);
   EXPECT_NE(missing.err.find("no character 'unicorn'"), std::string::npos) << missing.err;
   EXPECT_FALSE(fs::exists(dir / "u.glb"));
+}
+
+TEST(PredictCli, RigNetQuickStartPairIsPredictedWithOneWarningAboutItsSkinLines) {
+  TempDir dir;
+  // With --rig: the skin lines reference vertices beyond the 8 of the remeshed mesh.
+  const fs::path glb = dir / "17872.glb";
+  const Result r = run("predict " + kRigNet + "17872_remesh.obj --rig " + kRigNet +
+                       "17872_ori_rig.txt --out " + glb.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(glb));
+  geometry::ImportOptions o;
+  o.join_identical_vertices = false;
+  const geometry::Character skinned = geometry::import_character(glb, o);
+  EXPECT_EQ(skinned.mesh.num_vertices(), 8);
+  EXPECT_EQ(skinned.skeleton.names, (std::vector<std::string>{"root", "mid", "top"}));
+  const auto warnings = lines_with(r.err, "[warning]", true);
+  ASSERT_EQ(warnings.size(), 1u) << r.err;
+  EXPECT_NE(warnings[0].find("17872_ori_rig.txt:16: vertex 8 is out of range (the mesh has 8 "
+                             "vertices)"),
+            std::string::npos)
+      << warnings[0];
+  EXPECT_TRUE(error_lines(r.err).empty()) << r.err;
+
+  // Without --rig: the OBJ takes <id>_ori_rig.txt, which leaves vertex 6 without weight.
+  const fs::path rig = dir / "1347_rig.txt";
+  const Result beside = run("predict " + kRigNet + "1347_remesh.obj --out " + rig.string());
+  ASSERT_EQ(beside.status, 0) << beside.err;
+  EXPECT_EQ(geometry::read_rig(rig, 8).weights.rows(), 8) << "every vertex predicted";
+  const auto beside_warnings = lines_with(beside.err, "[warning]", true);
+  ASSERT_EQ(beside_warnings.size(), 1u) << beside.err;
+  EXPECT_NE(beside_warnings[0].find("1347_ori_rig.txt: vertex 6 has no weight"), std::string::npos)
+      << beside_warnings[0];
+
+  // Comparing and scoring need the skin lines: today's precise errors, nothing written.
+  const std::string pair = kRigNet + "17872_remesh.obj --rig " + kRigNet + "17872_ori_rig.txt";
+  const std::string precise = "17872_ori_rig.txt:16: vertex 8 is out of range (the mesh has 8 vertices)";
+  for (const std::string& args :
+       {"predict " + pair + " --compare-to-input --out " + (dir / "c.glb").string(),
+        "predict " + pair + " --render " + (dir / "c.png").string() + " --error-map",
+        "score " + pair + " --weights " + kRigNet + "17872_ori_rig.txt"}) {
+    const Result refused = run(args);
+    EXPECT_EQ(refused.status, 1) << args;
+    const auto lines = error_lines(refused.err);
+    ASSERT_EQ(lines.size(), 1u) << args << "\n" << refused.err;
+    EXPECT_NE(lines[0].find(precise), std::string::npos) << args << "\n" << lines[0];
+  }
+  const Result unweighted = run("predict " + kRigNet + "1347_remesh.obj --compare-to-input --out " +
+                                (dir / "u.glb").string());
+  EXPECT_EQ(unweighted.status, 1);
+  EXPECT_NE(unweighted.err.find("1347_ori_rig.txt: vertex 6 has no weight"), std::string::npos)
+      << unweighted.err;
+  EXPECT_FALSE(fs::exists(dir / "c.glb"));
+  EXPECT_FALSE(fs::exists(dir / "c.png"));
+  EXPECT_FALSE(fs::exists(dir / "u.glb"));
+
+  // A broken joint line is still an error naming the file and the line.
+  std::string text = read_file(fs::path(SKINLAB_SOURCE_DIR) / kRigNet / "17872_ori_rig.txt");
+  const std::string joint = "joints mid 0 0.5 0";
+  ASSERT_NE(text.find(joint), std::string::npos);
+  text.replace(text.find(joint), joint.size(), "joints mid 0 half 0");
+  const fs::path broken = dir / "broken_rig.txt";
+  write_file_atomic(broken, text);
+  const Result bad = run("predict " + kRigNet + "17872_remesh.obj --rig " + broken.string() +
+                         " --out " + (dir / "b.glb").string());
+  EXPECT_EQ(bad.status, 1);
+  const auto bad_lines = error_lines(bad.err);
+  ASSERT_EQ(bad_lines.size(), 1u) << bad.err;
+  EXPECT_NE(bad_lines[0].find("broken_rig.txt:4: bad coordinate 'half'"), std::string::npos)
+      << bad_lines[0];
+  EXPECT_FALSE(fs::exists(dir / "b.glb"));
+}
+
+TEST(PredictCli, BatchWritesTheGoodCharactersSkipsTheBadOnesAndSaysWhich) {
+  TempDir dir;
+  // A character whose joint lies far outside its mesh: it loads, then fails its check.
+  fs::copy_file(fs::path(SKINLAB_SOURCE_DIR) / kBad / "box.obj", dir / "far.obj");
+  fs::copy_file(fs::path(SKINLAB_SOURCE_DIR) / kBad / "bone_outside_rig.txt", dir / "far_rig.txt");
+  const std::string far = (dir / "far.obj").string();
+  const fs::path out = dir / "out";
+  const Result r = run("predict " + kBad + "box.obj " + kBad + "garbage.fbx " + kPlayer + " " +
+                       far + " " + kRigNet + "1347_remesh.obj --out-dir " + out.string());
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_EQ(files_in(out), (std::vector<std::string>{"1347_remesh.glb", "box.glb", "character.glb"}))
+      << "the good ones written, nothing for the bad ones, no temporary file left";
+  const geometry::Character box = geometry::import_character(out / "box.glb");
+  EXPECT_EQ(box.skeleton.names, (std::vector<std::string>{"root", "mid", "top"}));
+
+  // One line per bad file, naming it and the reason; then the run's own error.
+  const auto skipped = lines_with(r.err, "(skipped)", true);
+  ASSERT_EQ(skipped.size(), 2u) << r.err;
+  EXPECT_NE(skipped[0].find("garbage.fbx"), std::string::npos) << skipped[0];
+  EXPECT_NE(skipped[0].find("assimp cannot read it"), std::string::npos) << skipped[0];
+  EXPECT_NE(skipped[1].find("far.obj with " + (dir / "far_rig.txt").string()), std::string::npos)
+      << skipped[1];
+  EXPECT_NE(skipped[1].find("outside the mesh's bounding box"), std::string::npos) << skipped[1];
+  const auto errors = error_lines(r.err);
+  ASSERT_EQ(errors.size(), 1u) << r.err;
+  EXPECT_NE(errors[0].find("2 of 5 characters failed"), std::string::npos) << errors[0];
+
+  // The summary: every input with its status, counts and time.
+  EXPECT_NE(r.out.find("3 of 5 characters written to " + out.string()), std::string::npos) << r.out;
+  const std::string box_row = summary_row(r.out, kBad + "box.obj");
+  EXPECT_NE(box_row.find(" ok "), std::string::npos) << r.out;
+  EXPECT_NE(box_row.find(" 8 "), std::string::npos) << box_row;  // vertices
+  EXPECT_NE(summary_row(r.out, kPlayer).find(" ok "), std::string::npos) << r.out;
+  EXPECT_NE(summary_row(r.out, kRigNet + "1347_remesh.obj").find(" ok "), std::string::npos) << r.out;
+  EXPECT_NE(summary_row(r.out, kBad + "garbage.fbx").find(" failed "), std::string::npos) << r.out;
+  EXPECT_NE(summary_row(r.out, far).find(" failed "), std::string::npos) << r.out;
+}
+
+TEST(PredictCli, BatchTakesADirectoryAndAListFile) {
+  TempDir dir;
+  // A directory: its character files, sorted; the rig texts beside the OBJs are theirs.
+  const fs::path rigs = dir / "rigs";
+  const Result d = run("predict " + kRigNet + " --out-dir " + rigs.string() + " --format rig");
+  ASSERT_EQ(d.status, 0) << d.err;
+  EXPECT_EQ(files_in(rigs), (std::vector<std::string>{"1347_remesh_rig.txt", "17872_remesh_rig.txt"}));
+  EXPECT_EQ(geometry::read_rig(rigs / "17872_remesh_rig.txt", 8).weights.rows(), 8);
+  const std::string first = summary_row(d.out, kRigNet + "1347_remesh.obj");
+  const std::string second = summary_row(d.out, kRigNet + "17872_remesh.obj");
+  EXPECT_NE(first.find(" ok "), std::string::npos) << d.out;
+  EXPECT_NE(second.find(" ok "), std::string::npos) << d.out;
+  EXPECT_LT(d.out.find(first), d.out.find(second)) << "sorted by name\n" << d.out;
+  EXPECT_EQ(lines_with(d.err, "[warning]", true).size(), 2u) << "one per rig text\n" << d.err;
+
+  // A list: paths relative to the list file, comments and blank lines skipped.
+  fs::create_directories(dir / "chars");
+  fs::copy_file(fs::path(SKINLAB_SOURCE_DIR) / kBad / "box.obj", dir / "chars" / "crate.obj");
+  fs::copy_file(fs::path(SKINLAB_SOURCE_DIR) / kBad / "box_rig.txt", dir / "chars" / "crate_rig.txt");
+  const fs::path list = dir / "list.txt";
+  write_file_atomic(list, "# characters to skin\nchars/crate.obj\n\n  " + kPlayer + "  \n");
+  const fs::path h5 = dir / "h5";
+  const Result l = run("predict @" + list.string() + " --out-dir " + h5.string() + " --format h5");
+  ASSERT_EQ(l.status, 0) << l.err;
+  EXPECT_EQ(files_in(h5), (std::vector<std::string>{"character.h5", "crate.h5"}));
+  EXPECT_EQ(data::H5Reader(h5 / "crate.h5").read_double("joint_weights").rows(), 8);
+  EXPECT_NE(l.out.find("2 of 2 characters written"), std::string::npos) << l.out;
+}
+
+TEST(PredictCli, BatchUsageErrorsComeBeforeAnyWork) {
+  TempDir dir;
+  fs::copy_file(fs::path(SKINLAB_SOURCE_DIR) / kBad / "box.obj", dir / "box.obj");
+  fs::copy_file(fs::path(SKINLAB_SOURCE_DIR) / kBad / "box_rig.txt", dir / "box_rig.txt");
+  write_file_atomic(dir / "hero.glb", "an input the batch must not overwrite");
+  fs::create_directories(dir / "textures");
+  write_file_atomic(dir / "textures" / "skin.png", "not a character");
+  const fs::path out = dir / "out";
+  struct Case {
+    std::string args;
+    std::string message;
+  };
+  // A model that does not exist: every one of these errors must come before it is loaded.
+  const std::string model = " --model " + (dir / "nomodel").string();
+  const std::vector<Case> cases = {
+      {kBad + "box.obj " + (dir / "box.obj").string() + " --out-dir " + out.string(),
+       "predict: tests/data/bad/box.obj and " + (dir / "box.obj").string() +
+           " would both write " + (out / "box.glb").string()},
+      {(dir / "hero.glb").string() + " --out-dir " + dir.path().string(),
+       "would replace the input " + (dir / "hero.glb").string()},
+      {kBad + "box.obj " + kPlayer + " --out " + (dir / "x.glb").string(),
+       "2 inputs need --out-dir DIR"},
+      {kBad + "box.obj --out " + (dir / "x.glb").string() + " --out-dir " + out.string(),
+       "--out is for one input"},
+      {kRigNet + " --out " + (dir / "x.glb").string(), "a directory or list of characters needs --out-dir"},
+      {"@" + (dir / "absent.txt").string() + " --out-dir " + out.string(), "absent.txt"},
+      {(dir / "textures").string() + " --out-dir " + out.string(),
+       "textures: a directory without character files"},
+      {kBad + "box.obj --rig " + kBad + "box_rig.txt --out-dir " + out.string(),
+       "--rig goes with one OBJ input"},
+      {kBad + "box.obj --out-dir " + out.string() + " --render " + (dir / "x.png").string(),
+       "--render and --error-map draw one character"},
+  };
+  const auto before = files_in(dir.path());
+  for (const Case& c : cases) {
+    const Result r = run("predict " + c.args + model);
+    EXPECT_EQ(r.status, 1) << c.args << "\n" << r.err;
+    const auto lines = error_lines(r.err);
+    ASSERT_EQ(lines.size(), 1u) << c.args << "\n" << r.err;
+    EXPECT_NE(lines[0].find(c.message), std::string::npos) << c.args << "\n" << lines[0];
+    EXPECT_EQ(lines[0].find("not a model directory"), std::string::npos) << lines[0];
+    EXPECT_EQ(files_in(dir.path()), before) << c.args << ": something was written";
+  }
+  EXPECT_EQ(read_file(dir / "hero.glb"), "an input the batch must not overwrite");
 }
 
 }  // namespace SKINLAB_UNITY_ID

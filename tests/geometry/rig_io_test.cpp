@@ -1,8 +1,13 @@
 // RigNet rig text and OBJ files: round trips and every malformed-line error with its line number.
 
 #include <gtest/gtest.h>
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
+
+#include <sstream>
 
 #include "framework/core/atomic_file.hpp"
+#include "framework/geometry/load_character.hpp"
 #include "framework/geometry/obj_io.hpp"
 #include "framework/geometry/rig_io.hpp"
 #include "tests/test_util.hpp"
@@ -131,6 +136,139 @@ TEST(RigIo, MalformedLinesNameTheLine) {
     const auto file = dir.write("case" + std::to_string(n++) + ".txt", c.text);
     expect_error<GeometryError>([&] { read_rig(file, 2); }, {file.filename().string(), c.message});
   }
+}
+
+/// Collects what is logged while it lives (the default logger is restored after).
+class LogCapture {
+ public:
+  LogCapture() : previous_(spdlog::default_logger()) {
+    auto logger = std::make_shared<spdlog::logger>(
+        "capture", std::make_shared<spdlog::sinks::ostream_sink_st>(stream_));
+    logger->set_pattern("[%l] %v");
+    spdlog::set_default_logger(logger);
+  }
+  ~LogCapture() { spdlog::set_default_logger(previous_); }
+  /// The lines logged at `level` ("warning", "info", ...).
+  std::vector<std::string> lines(const std::string& level) const {
+    std::vector<std::string> found;
+    std::istringstream in(stream_.str());
+    for (std::string line; std::getline(in, line);) {
+      if (line.rfind("[" + level + "] ", 0) == 0) found.push_back(line);
+    }
+    return found;
+  }
+
+ private:
+  std::ostringstream stream_;
+  std::shared_ptr<spdlog::logger> previous_;
+};
+
+TEST(RigIo, IgnoringSkinLinesKeepsTheSkeletonAndWarnsOnceWithTheStrictError) {
+  TempDir dir;
+  const std::string head = "joints a 0 0 0\njoints b 0 1 0\nroot a\nhier a b\n";  // lines 1-4
+  // Every kind of skin-line problem: under `ignore_mismatch` the skeleton comes back without
+  // weights, and the warning is the error `require` throws.
+  const std::vector<std::string> skin_cases = {
+      head + "skin 0 a\n",
+      head + "skin 9 a 1\nskin 0 a 1\nskin 10 b 1\n",
+      head + "skin 0 a 1\nskin 0 b 1\n",
+      head + "skin 0 c 1\nskin 1 b 1\n",
+      head + "skin 0 a one\n",
+      head + "skin 0 a 1\n",
+      head + "skin 0 a 0.5\nskin 1 b 1\n",
+      head + "skin 0 a -1 b 2\nskin 1 b 1\n",
+      head + "skin 0 a 0.5 a 0.5\nskin 1 b 1\n",
+      // skin lines before the skeleton's last lines: the skeleton is still read whole
+      "joints a 0 0 0\njoints b 0 1 0\nskin 5 a 1\nroot a\nhier a b\n",
+  };
+  int n = 0;
+  for (const auto& text : skin_cases) {
+    const auto file = dir.write("skin" + std::to_string(n++) + ".txt", text);
+    std::string strict;
+    try {
+      read_rig(file, 2);
+    } catch (const GeometryError& e) {
+      strict = e.what();
+    }
+    ASSERT_FALSE(strict.empty()) << text;
+    LogCapture log;
+    const Rig rig = read_rig(file, 2, {}, SkinLines::ignore_mismatch);
+    EXPECT_EQ(rig.skeleton.names, (std::vector<std::string>{"a", "b"})) << text;
+    EXPECT_EQ(rig.skeleton.parents, (std::vector<int>{-1, 0})) << text;
+    EXPECT_EQ(rig.weights.rows(), 0) << text;
+    EXPECT_EQ(rig.ignored_skin, strict) << text;
+    const auto warnings = log.lines("warning");
+    ASSERT_EQ(warnings.size(), 1u) << text;
+    EXPECT_NE(warnings[0].find(strict), std::string::npos) << warnings[0];
+  }
+  // Skin lines that fit are kept, without a warning.
+  LogCapture log;
+  const Rig fits = read_rig(dir.write("fits.txt", kRig), 4, {}, SkinLines::ignore_mismatch);
+  EXPECT_EQ(fits.weights.nonZeros(), 6);
+  EXPECT_TRUE(fits.ignored_skin.empty());
+  EXPECT_TRUE(log.lines("warning").empty());
+}
+
+TEST(RigIo, IgnoringSkinLinesLeavesSkeletonErrorsStrict) {
+  TempDir dir;
+  const std::string skin = "skin 7 a 1\n";  // out of range for 2 vertices: ignored
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {skin + "joints a 0 0\n", ":2: expected 'joints NAME x y z'"},
+      {"joints a 0 0 0\njoints b 0 x 0\nroot a\nhier a b\n" + skin, ":2: bad coordinate 'x'"},
+      {"joints a 0 0 0\njoints b 0 1 0\nroot a\nhier z b\n" + skin, ":4: unknown joint 'z'"},
+      {"joints a 0 0 0\njoints b 0 1 0\nroot a\n" + skin, "joint 'b' has no 'hier' line"},
+      {"joints a 0 0 0\njoints b 0 1 0\nroot a\nhier a b\nbone a b\n" + skin,
+       ":5: unknown statement 'bone'"},
+  };
+  int n = 0;
+  for (const auto& [text, message] : cases) {
+    const auto file = dir.write("skel" + std::to_string(n++) + ".txt", text);
+    expect_error<GeometryError>([&] { read_rig(file, 2, {}, SkinLines::ignore_mismatch); },
+                                {file.filename().string(), message});
+  }
+}
+
+TEST(RigIo, RigNetQuickStartPairsReadTheirSkeletonWithoutTheOriginalMeshsWeights) {
+  // tests/data/rignet/: remeshed OBJs with the rig texts of their original meshes.
+  const std::filesystem::path data = std::filesystem::path(SKINLAB_SOURCE_DIR) / "tests/data/rignet";
+  EXPECT_EQ(rig_beside(data / "17872_remesh.obj"), data / "17872_ori_rig.txt");
+  EXPECT_EQ(rig_beside(data / "1347_remesh.obj"), data / "1347_ori_rig.txt");
+  EXPECT_TRUE(rig_beside(data / "17872_ori_rig.txt").empty());
+  expect_error<GeometryError>(
+      [&] { load_character(data / "17872_remesh.obj"); },
+      {"17872_ori_rig.txt:16: vertex 8 is out of range (the mesh has 8 vertices)"});
+  expect_error<GeometryError>([&] { load_character(data / "1347_remesh.obj"); },
+                              {"1347_ori_rig.txt: vertex 6 has no weight"});
+  const Character out_of_range =
+      load_character(data / "17872_remesh.obj", {}, SkinLines::ignore_mismatch);
+  EXPECT_EQ(out_of_range.name, "17872_remesh");
+  EXPECT_EQ(out_of_range.mesh.num_vertices(), 8);
+  EXPECT_EQ(out_of_range.skeleton.names, (std::vector<std::string>{"root", "mid", "top"}));
+  EXPECT_FALSE(out_of_range.has_weights());
+  const Character unweighted = load_character(data / "1347_remesh.obj", data / "1347_ori_rig.txt",
+                                              SkinLines::ignore_mismatch);
+  EXPECT_FALSE(unweighted.has_weights());
+  EXPECT_EQ(unweighted.skeleton.num_joints(), 3);
+}
+
+TEST(LoadCharacter, AnObjTakesTheRigTextNextToItInADocumentedOrder) {
+  TempDir dir;
+  const std::string skeleton = "joints a 0 0 0\njoints b 0 1 0\nroot a\nhier a b\n";
+  const auto obj = dir.write("hero.obj", kObj);
+  expect_error<GeometryError>([&] { load_character(obj); },
+                              {"hero.obj: an OBJ mesh has no skeleton", "hero_rig.txt, hero.txt"});
+  dir.write("hero.txt", skeleton);
+  EXPECT_EQ(rig_beside(obj), dir / "hero.txt");
+  EXPECT_EQ(load_character(obj).skeleton.num_joints(), 2);
+  dir.write("hero_rig.txt", kRig);
+  EXPECT_EQ(rig_beside(obj), dir / "hero_rig.txt");
+  EXPECT_EQ(load_character(obj).skeleton.num_joints(), 3);
+  EXPECT_TRUE(rig_candidates(dir / "hero.fbx").empty()) << "other formats carry their skeleton";
+  EXPECT_EQ(rig_candidates(dir / "7_remesh.obj").back(), dir / "7_ori_rig.txt");
+  EXPECT_TRUE(is_character_file("a/b.GLB"));
+  EXPECT_TRUE(is_character_file("b.obj"));
+  EXPECT_FALSE(is_character_file("b_rig.txt"));
+  EXPECT_FALSE(is_character_file("b.blend"));
 }
 
 TEST(RigIo, WriterRejectsUnwritableNames) {
