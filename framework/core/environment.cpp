@@ -98,14 +98,18 @@ double peak_memory_mib() {
   return 0.0;
 }
 
-nlohmann::json collect_environment(std::uint64_t seed, const std::vector<std::string>& command) {
-  std::array<char, 256> host{};
-  if (::gethostname(host.data(), host.size() - 1) != 0) host[0] = '\0';
+std::string utc_time_text() {
   const std::time_t now = std::time(nullptr);
   std::tm utc{};
   ::gmtime_r(&now, &utc);
-  std::array<char, 32> time_text{};
-  std::strftime(time_text.data(), time_text.size(), "%Y-%m-%dT%H:%M:%SZ", &utc);
+  std::array<char, 32> text{};
+  std::strftime(text.data(), text.size(), "%Y-%m-%dT%H:%M:%SZ", &utc);
+  return text.data();
+}
+
+nlohmann::json collect_environment(std::uint64_t seed, const std::vector<std::string>& command) {
+  std::array<char, 256> host{};
+  if (::gethostname(host.data(), host.size() - 1) != 0) host[0] = '\0';
   nlohmann::json env = git_json(build_git_state());
   env.update({
       {"build_type", SKINLAB_BUILD_TYPE},
@@ -114,7 +118,7 @@ nlohmann::json collect_environment(std::uint64_t seed, const std::vector<std::st
       {"hardware_threads", static_cast<int>(::sysconf(_SC_NPROCESSORS_ONLN))},
       {"seed", seed},
       {"host", host.data()},
-      {"time_utc", time_text.data()},
+      {"time_utc", utc_time_text()},
       {"command", command},
   });
   return env;

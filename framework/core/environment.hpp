@@ -61,6 +61,9 @@ struct ComputeRuntime {
 /// wins; without one, library_versions() lists none and collect_environment() records 1 thread.
 void register_compute_runtime(ComputeRuntime runtime);
 
+/// The current time, UTC, ISO 8601 to the second ("2026-12-03T17:02:15Z"), as env.json records it.
+std::string utc_time_text();
+
 /// The `env.json` record of a run: git commit and dirty flag of the source tree, compiler,
 /// library versions, build type, thread count, seed, host name, time (UTC, ISO 8601) and the
 /// command line.

@@ -56,17 +56,9 @@ std::vector<int> drop_weightless_leaves(Character& character) {
     const int p = s.parents[j];
     kept.parents.push_back(p < 0 ? -1 : new_index[static_cast<std::size_t>(p)]);
   }
-  SparseWeights W(character.weights.rows(), m);
-  std::vector<Eigen::Triplet<double>> triplets;
-  for (int v = 0; v < character.weights.outerSize(); ++v) {
-    for (SparseWeights::InnerIterator it(character.weights, v); it; ++it) {
-      triplets.emplace_back(v, new_index[static_cast<std::size_t>(it.col())], it.value());
-    }
-  }
-  W.setFromTriplets(triplets.begin(), triplets.end());
-  W.makeCompressed();
+  // the removed joints carry no weight, so this only re-indexes the kept columns
+  character.weights = onto_kept_joints(character.weights, s.parents, kept_joints);
   s = std::move(kept);
-  character.weights = std::move(W);
   return kept_joints;
 }
 

@@ -132,12 +132,12 @@ FitStart start_fit(const RunDir& run, torch::nn::Module& model, torch::optim::Op
     set_rng_state(order_rng, saved.order_rng);
     start.resumed = true;
     if (writer) {
-      const nlohmann::json env = collect_environment(static_cast<std::uint64_t>(seed), {});
+      const GitState& git = build_git_state();
       run.record_resume({{"after_epoch", state.epoch},
-                         {"git_commit", env["git_commit"]},
-                         {"git_dirty", env["git_dirty"]},
+                         {"git_commit", git.commit},
+                         {"git_dirty", git.dirty},
                          {"threads", state.threads},
-                         {"time_utc", env["time_utc"]}});
+                         {"time_utc", utc_time_text()}});
     }
     spdlog::info("resuming {} after epoch {} (best epoch {}, loss {:.6g})", run.path().string(),
                  state.epoch, state.best_epoch, state.best_loss);
