@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <mutex>
 
 #include <fmt/core.h>
 
@@ -17,21 +18,52 @@ std::string format_duration(double seconds) {
   return fmt::format("{}:{:02}:{:02}", s / 3600, s / 60 % 60, s % 60);
 }
 
-Progress::Sink default_sink() {
-  if (::isatty(STDERR_FILENO)) {
-    return [](const std::string& line, bool final) {
-      std::fprintf(stderr, "\r\033[K%s%s", line.c_str(), final ? "\n" : "");
-      std::fflush(stderr);
-    };
-  }
+/// The bar drawn last on the terminal, while it is not finished (log lines move it down).
+struct TerminalLine {
+  std::mutex mutex;
+  std::string text;
+  std::FILE* out = nullptr;  ///< where it is drawn; null when no bar is drawn
+};
+
+TerminalLine& terminal_line() {
+  static TerminalLine line;
+  return line;
+}
+
+Progress::Sink log_sink() {
   return [](const std::string& line, bool) { spdlog::info("{}", line); };
 }
 
 }  // namespace
 
+Progress::Sink Progress::terminal_sink(std::FILE* out) {
+  return [out](const std::string& line, bool final) {
+    TerminalLine& bar = terminal_line();
+    const std::lock_guard<std::mutex> lock(bar.mutex);
+    std::fprintf(out, "\r\033[K%s%s", line.c_str(), final ? "\n" : "");
+    std::fflush(out);
+    bar.text = line;
+    bar.out = final ? nullptr : out;
+  };
+}
+
+void Progress::around_log_line(const std::function<void()>& write) {
+  TerminalLine& bar = terminal_line();
+  const std::lock_guard<std::mutex> lock(bar.mutex);
+  if (bar.out != nullptr) {
+    std::fputs("\r\033[K", bar.out);
+    std::fflush(bar.out);
+  }
+  write();
+  if (bar.out != nullptr) {
+    std::fputs(bar.text.c_str(), bar.out);
+    std::fflush(bar.out);
+  }
+}
+
 Progress::Progress(std::string label, std::size_t total, double interval_seconds)
     : Progress(std::move(label), total, ::isatty(STDERR_FILENO) ? 0.1 : interval_seconds,
-               default_sink()) {}
+               ::isatty(STDERR_FILENO) ? terminal_sink(stderr) : log_sink()) {}
 
 Progress::Progress(std::string label, std::size_t total, double interval_seconds, Sink sink)
     : label_(std::move(label)),
@@ -50,6 +82,7 @@ Progress::~Progress() {
 
 void Progress::tick(std::size_t n) {
   done_ += n;
+  if (total_ > 0 && done_ >= total_) return;  // finish() reports the last line, once
   const auto now = Clock::now();
   if (std::chrono::duration<double>(now - last_).count() >= interval_) {
     last_ = now;

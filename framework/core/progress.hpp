@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cstddef>
+#include <cstdio>
 #include <functional>
 #include <string>
 
@@ -23,10 +24,18 @@ class Progress {
   Progress(std::string label, std::size_t total, double interval_seconds, Sink sink);
   ~Progress();
 
-  /// Advances by `n` steps.
+  /// Advances by `n` steps. Reaching the total reports nothing: finish() reports the last line.
   void tick(std::size_t n = 1);
   /// Reports the final line (also done by the destructor if not called).
   void finish();
+
+  /// The sink that draws the bar on a terminal `out` (stderr when it is a tty): the line is
+  /// redrawn in place, and the final one ends with a newline.
+  static Sink terminal_sink(std::FILE* out);
+  /// Runs `write` (which writes whole lines, e.g. a log sink) so that they do not land on a bar
+  /// being drawn by terminal_sink: the bar is cleared first and redrawn under them. logging.cpp's
+  /// console sink writes through it.
+  static void around_log_line(const std::function<void()>& write);
 
   /// "label 12/100 (12.0%) 3.40/s ETA 0:00:26"; without a total, "label 12 3.40/s".
   static std::string format(const std::string& label, std::size_t done, std::size_t total,

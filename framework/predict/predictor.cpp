@@ -152,7 +152,12 @@ Prediction Predictor::predict(const geometry::Character& character, const Predic
   mode.laplacian = false;
   data::PreprocessTimes pre;
   Prediction out;
-  out.prepared = data::preprocess(source, distances_, preprocess_, mode, &pre);
+  // The prediction does not depend on the input's weights: no weightless end joints are dropped
+  // (which ones are weightless is the input weights' word), so the prediction covers every joint
+  // of the input's skeleton, as the files it is written to do.
+  data::PreprocessOptions preprocess = preprocess_;
+  preprocess.drop_weightless_leaves = 0;
+  out.prepared = data::preprocess(source, distances_, preprocess, mode, &pre);
   if (times != nullptr) {
     times->normalise += pre.normalise;
     times->distance += pre.distance;

@@ -101,7 +101,10 @@ class Predictor {
                      StageTimes* times = nullptr) const;
 
   /// The metrics of the model's config (`metrics:`) of `p` against the weights the input
-  /// carried (HeterSkinNet Sec. 4.3). Throws Error when the input had no weights.
+  /// carried (HeterSkinNet Sec. 4.3), on every joint of the input's skeleton (a preparation's
+  /// drop_weightless_leaves does not apply to predictions; to score as `eval` does on a dataset
+  /// that drops them, score p.joint_weights with score()). Throws Error when the input had no
+  /// weights.
   std::map<std::string, double> compare(const Prediction& p) const;
 
   /// The metrics of the model's config of another method's per-joint weights `other` (#V×#J of

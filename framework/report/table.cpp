@@ -11,6 +11,7 @@
 #include "framework/core/config.hpp"
 #include "framework/core/error.hpp"
 #include "framework/eval/anova.hpp"
+#include "framework/eval/paired_t.hpp"
 #include "framework/eval/value_display.hpp"
 
 namespace skinlab::report {
@@ -146,6 +147,15 @@ void require_format(const TableOptions& options) {
   }
 }
 
+/// The mark of a run made (or resumed) by a build from a modified tree.
+std::string dirty_mark(const RunResult& run) { return run.dirty ? "†" : ""; }
+
+/// The note under a Markdown table with a marked run.
+const char* const kDirtyNote =
+    "† made or resumed by a build from a modified source tree (`git_dirty` in the run's "
+    "env.json): its commit alone does not name its code; `git_modified` and `git_diff_sha256` "
+    "there say how it differed (runs before 2026-12-03 recorded only the flag).\n";
+
 /// One row of a table: a run, or (group_runs) every run of one experiment, all on the same
 /// characters.
 struct Row {
@@ -154,8 +164,11 @@ struct Row {
 
   std::string run_ids() const {
     std::string ids;
-    for (const auto* r : runs) ids += (ids.empty() ? "" : ", ") + r->run_id;
+    for (const auto* r : runs) ids += (ids.empty() ? "" : ", ") + r->run_id + dirty_mark(*r);
     return ids;
+  }
+  bool any_dirty() const {
+    return std::any_of(runs.begin(), runs.end(), [](const RunResult* r) { return r->dirty; });
   }
   /// Each character's mean over the runs (NaN where every run's value is NaN).
   std::vector<double> character_means(const std::string& metric) const {
@@ -183,6 +196,17 @@ std::optional<eval::Anova> anova_of(const std::vector<double>& a, const std::vec
   const auto x = defined(a), y = defined(b);
   if (x.empty() || y.empty() || x.size() + y.size() < 3) return std::nullopt;
   return eval::one_way_anova({x, y});
+}
+
+/// The paired t-test of two per-character value lists on the same characters (row − reference),
+/// or nothing when fewer than two characters have both values defined.
+std::optional<eval::PairedT> paired_of(const std::vector<double>& reference, const std::vector<double>& b) {
+  std::size_t pairs = 0;
+  for (std::size_t i = 0; i < std::min(reference.size(), b.size()); ++i) {
+    pairs += !std::isnan(reference[i]) && !std::isnan(b[i]);
+  }
+  if (reference.size() != b.size() || pairs < 2) return std::nullopt;
+  return eval::paired_t_test(reference, b);
 }
 
 /// The metric definitions quoted under a Markdown table (the first run's).
@@ -234,6 +258,19 @@ RunResult load_run_result(const fs::path& dir, const std::string& part) {
       throw IoError(file.string() + ": metric '" + name + "' is missing for some characters");
     }
   }
+  // A run made or resumed by a build from a modified tree (core/environment.hpp, git_json).
+  const fs::path env = dir / "env.json";
+  if (fs::exists(env)) {
+    try {
+      const auto j = nlohmann::json::parse(read_file(env));
+      r.dirty = j.value("git_dirty", false);
+      for (const auto& resume : j.value("resumes", nlohmann::json::array())) {
+        r.dirty = r.dirty || resume.value("git_dirty", false);
+      }
+    } catch (const nlohmann::json::exception& e) {
+      throw IoError(env.string() + ": not a run environment record (" + e.what() + ")");
+    }
+  }
   const fs::path config = dir / "config.yaml";
   if (fs::exists(config)) {
     const config::Node metrics = config::Config::load(config.string()).root()["metrics"];
@@ -279,26 +316,35 @@ std::string make_table(const std::vector<RunResult>& runs, const TableOptions& o
   if (md && !options.title.empty()) out += "### " + options.title + "\n\n";
   if (options.format == "tex") out += "\\begin{table}\n\\centering\n";
   out += render(main, options.format, 2);
+  // Rows of one experiment (e.g. seeds not grouped) are told apart by their run ids.
+  auto name = [&](const Row& row) {
+    int same = 0;
+    for (const auto& other : rows) same += other.label == row.label;
+    return same > 1 ? row.label + " (" + row.run_ids() + ")" : row.label;
+  };
   // An ANOVA needs two characters per run (a CI smoke run on one test character has none).
   if (rows.size() > 1 && ref.characters.size() > 1) {
-    // Rows of one experiment (e.g. seeds not grouped) are told apart by their run ids.
-    auto name = [&](const Row& row) {
-      int same = 0;
-      for (const auto& other : rows) same += other.label == row.label;
-      return same > 1 ? row.label + " (" + row.run_ids() + ")" : row.label;
-    };
     std::vector<std::vector<std::string>> anova{{"One-way ANOVA vs " + name(rows.front())}};
-    for (const auto& m : options.metrics) anova.front().push_back(eval::value_display(m).column_header() + " F (p)");
-    for (std::size_t r = 1; r < rows.size(); ++r) {
-      std::vector<std::string> cells{name(rows[r])};
-      for (const auto& m : options.metrics) {
-        const auto a = anova_of(rows.front().character_means(m), rows[r].character_means(m));
-        cells.push_back(a ? fmt::format("{:.4f} ({})", a->F, p_text(a->p)) : "n/a");
-      }
-      anova.push_back(std::move(cells));
+    std::vector<std::vector<std::string>> paired{{"Paired t-test vs " + name(rows.front())}};
+    for (const auto& m : options.metrics) {
+      anova.front().push_back(eval::value_display(m).column_header() + " F (p)");
+      paired.front().push_back(eval::value_display(m).column_header() + " t (p)");
     }
-    out += md ? "\n" : options.format == "csv" ? "\n" : "\\medskip\n";
-    out += render(anova, options.format, 1);
+    for (std::size_t r = 1; r < rows.size(); ++r) {
+      std::vector<std::string> a_cells{name(rows[r])}, t_cells{name(rows[r])};
+      for (const auto& m : options.metrics) {
+        const auto reference = rows.front().character_means(m), values = rows[r].character_means(m);
+        const auto a = anova_of(reference, values);
+        a_cells.push_back(a ? fmt::format("{:.4f} ({})", a->F, p_text(a->p)) : "n/a");
+        const auto t = paired_of(reference, values);
+        t_cells.push_back(t ? fmt::format("{:.4f} ({})", t->t, p_text(t->p)) : "n/a");
+      }
+      anova.push_back(std::move(a_cells));
+      paired.push_back(std::move(t_cells));
+    }
+    const std::string gap = md || options.format == "csv" ? "\n" : "\\medskip\n";
+    out += gap + render(anova, options.format, 1);
+    out += gap + render(paired, options.format, 1);
   }
   if (options.format == "tex" && !options.title.empty()) {
     out += "\\caption{" + tex_escape(options.title) + "}\n";
@@ -313,6 +359,13 @@ std::string make_table(const std::vector<RunResult>& runs, const TableOptions& o
              "the runs of their means, and its ANOVA uses each character's mean over the runs";
     }
     out += ".\n";
+    if (rows.size() > 1 && ref.characters.size() > 1) {
+      out += "The one-way ANOVA (the paper's test, Sec. 4.5) treats the two rows' values as "
+             "independent samples; the paired t-test uses each character's difference (row − " +
+             name(rows.front()) + ", t > 0 where the row is larger), as both rows score the same "
+             "characters; p is two-sided.\n";
+    }
+    if (std::any_of(rows.begin(), rows.end(), [](const Row& r) { return r.any_dirty(); })) out += kDirtyNote;
     out += definitions_text(ref);
     if (!options.command.empty()) out += "Generated by `" + options.command + "`.\n";
   }
@@ -375,6 +428,13 @@ std::string make_split_table(const std::vector<RunResult>& runs, const TableOpti
     const auto at = cells.find({label, col});
     return at == cells.end() ? nullptr : &at->second;
   };
+  auto any_dirty_of = [&](const std::string& label) {
+    for (std::size_t col = 0; col < columns.size(); ++col) {
+      const Row* cell = find_cell(label, col);
+      if (cell != nullptr && cell->any_dirty()) return true;
+    }
+    return false;
+  };
   // The union's per-character values of a method evaluated on every column (else empty).
   auto pooled = [&](const std::string& label, const std::string& metric) {
     std::vector<double> all;
@@ -402,7 +462,12 @@ std::string make_split_table(const std::vector<RunResult>& runs, const TableOpti
       std::string text = value_text(stats_of(values).mean, display);
       if (!is_reference) {
         const auto a = anova_of(ref_values, values);
-        if (a) text += " (p " + p_text(a->p) + ")";
+        const auto t = paired_of(ref_values, values);
+        if (a && t) {
+          text += " (p " + p_text(a->p) + "; paired " + p_text(t->p) + ")";
+        } else if (a) {
+          text += " (p " + p_text(a->p) + ")";
+        }
       }
       return text;
     };
@@ -417,12 +482,15 @@ std::string make_split_table(const std::vector<RunResult>& runs, const TableOpti
         }
         row.push_back(cell_text(cell->character_means(m),
                                 ref_cell ? ref_cell->character_means(m) : std::vector<double>{},
-                                label == reference || ref_cell == nullptr));
+                                label == reference || ref_cell == nullptr) +
+                      (cell->any_dirty() ? "†" : ""));
       }
       if (union_column) {
         const auto all = pooled(label, m);
         const auto ref_all = pooled(reference, m);
-        row.push_back(all.empty() ? "—" : cell_text(all, ref_all, label == reference || ref_all.empty()));
+        row.push_back(all.empty() ? "—"
+                                  : cell_text(all, ref_all, label == reference || ref_all.empty()) +
+                                        (any_dirty_of(label) ? "†" : ""));
       }
       table.push_back(std::move(row));
     }
@@ -436,14 +504,15 @@ std::string make_split_table(const std::vector<RunResult>& runs, const TableOpti
   if (md) {
     out += "\nMean over each test set's characters";
     if (options.group_runs) out += " (a method with several runs, e.g. seeds: of each character's mean over its runs)";
-    out += "; (p …): one-way ANOVA over the same characters against " + reference +
-           ". Test sets: ";
+    out += "; (p …; paired …): two-sided p of the one-way ANOVA (the paper's test, Sec. 4.5) and "
+           "of the paired t-test over the same characters against " + reference + ". Test sets: ";
     for (std::size_t col = 0; col < columns.size(); ++col) {
       const RunResult& r = *column_ref[col];
       out += fmt::format("{}{}: {} characters, {} part of split '{}' of `{}`", col ? "; " : "",
                          columns[col].name, r.characters.size(), r.part, r.split, r.dataset);
     }
     out += ".\n";
+    if (std::any_of(runs.begin(), runs.end(), [](const RunResult& r) { return r.dirty; })) out += kDirtyNote;
     out += definitions_text(runs.front());
     if (!options.command.empty()) out += "Generated by `" + options.command + "`.\n";
   }

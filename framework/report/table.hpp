@@ -5,8 +5,10 @@
 /// reads each run's `eval_<part>.json` (framework/eval/evaluator.hpp) and writes one row per run:
 /// mean ± standard deviation over the part's characters of every metric, and a one-way ANOVA
 /// (eval/anova.hpp) of the per-character values of the reference run (the first) against each
-/// other run, per metric (Sec. 4.5, Fig. 9); with a single character per run there is no
-/// ANOVA (no degrees of freedom within), only the rows.
+/// other run, per metric (Sec. 4.5, Fig. 9), and beside it a paired t-test on the same
+/// characters (eval/paired_t.hpp: the two rows are not independent samples); with a single
+/// character per run there are no tests (no degrees of freedom), only the rows. A run made or
+/// resumed by a build from a modified source tree (its env.json) is marked † with a note.
 ///
 /// Every run must have been evaluated on the same characters (same dataset, split and part);
 /// otherwise the comparison would not mean anything, and it is an error naming the run and the
@@ -34,9 +36,13 @@ struct RunResult {
   /// A task's own statement of what its values are (eval_<part>.json `metric_definitions`;
   /// the corrective task's errors have no `metrics:` section), stated under the table instead.
   std::string metric_definitions;
+  /// The run's env.json says a build from a modified tree made or resumed it (`git_dirty`, or a
+  /// resume's); tables mark it with †. False without an env.json.
+  bool dirty = false;
 };
 
-/// Reads `<dir>/eval_<part>.json` and the `metrics` section of `<dir>/config.yaml`. Throws
+/// Reads `<dir>/eval_<part>.json`, the `metrics` section of `<dir>/config.yaml` and the git state
+/// of `<dir>/env.json` (each of the last two if present). Throws
 /// IoError naming the file when it is missing (with the `skinlab eval` command that writes it)
 /// or malformed.
 RunResult load_run_result(const std::filesystem::path& dir, const std::string& part);
@@ -64,7 +70,8 @@ std::string make_table(const std::vector<RunResult>& runs, const TableOptions& o
 /// leave-one-source-out splits, in order of appearance) and, with more than one, their union
 /// (every character of every column, for a method evaluated on all of them). One such table per
 /// metric; a cell is the mean over its characters and, below the first row, the p of a one-way
-/// ANOVA over characters against the first row's method on the same characters. A cell with
+/// ANOVA and of a paired t-test over characters against the first row's method on the same
+/// characters. A cell with
 /// several runs of one method needs `group_runs` (then each character's mean over the runs).
 /// make_table dispatches here when `options.across_splits` is set. Throws Error as make_table,
 /// and when a cell's runs, or a column's methods, were evaluated on different characters.

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <string>
 #include <vector>
 
 namespace skinlab {
@@ -27,11 +29,39 @@ TEST(Progress, ReportsPeriodicallyAndOnceAtTheEnd) {
     progress.finish();
     progress.finish();  // idempotent
   }  // destructor after finish() reports nothing more
-  ASSERT_EQ(lines.size(), 3u);
+  // the tick that reaches the total does not report: the final line is the only 3/3 line
+  ASSERT_EQ(lines.size(), 2u);
   EXPECT_EQ(lines[0].first.rfind("items 1/3", 0), 0u);
-  EXPECT_FALSE(lines[1].second);
-  EXPECT_EQ(lines[2].first.rfind("items 3/3 (100.0%)", 0), 0u);
-  EXPECT_TRUE(lines[2].second);
+  EXPECT_FALSE(lines[0].second);
+  EXPECT_EQ(lines[1].first.rfind("items 3/3 (100.0%)", 0), 0u);
+  EXPECT_TRUE(lines[1].second);
+}
+
+TEST(Progress, ALogLineOnTheTerminalMovesTheBarBelowIt) {
+  std::FILE* out = std::tmpfile();
+  ASSERT_NE(out, nullptr);
+  auto log = [&] { std::fputs("[info] a log line\n", out); };
+  {
+    Progress progress("items", 2, 0.0, Progress::terminal_sink(out));
+    progress.tick();
+    Progress::around_log_line(log);  // while the bar is drawn
+    progress.tick();
+  }
+  Progress::around_log_line(log);  // after the final line: written as is
+  std::rewind(out);
+  std::string text;
+  for (int ch; (ch = std::fgetc(out)) != EOF;) text += static_cast<char>(ch);
+  std::fclose(out);
+  // drawn, cleared for the log line, redrawn under it, then replaced by the final line
+  const auto first = text.find("\r\033[Kitems 1/2 (50.0%)");
+  const auto cleared = text.find("\r\033[K[info] a log line\nitems 1/2 (50.0%)");
+  const auto last = text.find("\r\033[Kitems 2/2 (100.0%)");
+  EXPECT_EQ(first, 0u) << text;
+  EXPECT_NE(cleared, std::string::npos) << text;
+  EXPECT_NE(last, std::string::npos) << text;
+  EXPECT_LT(cleared, last) << text;
+  EXPECT_EQ(text.substr(text.size() - 19), "\n[info] a log line\n") << text;
+  EXPECT_EQ(text.find("items 2/2", last + 5), std::string::npos) << "the last line twice: " << text;
 }
 
 TEST(Progress, LongIntervalOnlyReportsTheEnd) {

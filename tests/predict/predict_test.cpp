@@ -62,7 +62,7 @@ const char* kPreparation =
 
 /// Writes a run directory (config.yaml, best.pt with an optimizer, a dataset file carrying only
 /// the `preparation` attribute) into `dir`; returns it.
-fs::path write_run(const TempDir& dir) {
+fs::path write_run(const TempDir& dir, const std::string& preparation = kPreparation) {
   const fs::path run = dir / "run";
   fs::create_directories(run);
   std::string config = kConfig;
@@ -70,7 +70,7 @@ fs::path write_run(const TempDir& dir) {
   config.replace(config.find("unused.h5"), 9, data);
   write_file_atomic(run / "config.yaml", config);
   data::H5Writer h5(data);
-  h5.write_attribute("preparation", kPreparation);
+  h5.write_attribute("preparation", preparation);
   h5.commit();
   const train::RunOptions options = train::RunOptions::from(config::Config::parse(config));
   const auto model = train::build_model(options);
@@ -194,6 +194,36 @@ TEST(Predictor, ObjWithRigTextWithoutWeightsAndTheRigTextOutputRoundTrips) {
   // A vertex at the top of the tube follows the upper chain more than the root joint does.
   const int top = testing::Chain::vertex(testing::Chain::kRings - 1, 0);
   EXPECT_LT(p.joint_weights.coeff(top, 0), 0.5);
+}
+
+TEST(Predictor, APreparationThatDropsWeightlessEndJointsStillPredictsEveryJoint) {
+  // The model's preparation drops every character's weightless end joints (probability 1); an
+  // input whose top joint carries no weight still gets a prediction over all its joints.
+  TempDir dir;
+  std::string preparation = kPreparation;
+  preparation.insert(preparation.find("  top_k"), "  drop_weightless_leaves: 1.0\n");
+  const auto predictor = predict::Predictor::load(write_run(dir, preparation));
+  const auto chain = testing::chain();
+  geometry::Character c;
+  c.name = "chain";
+  c.mesh = chain.mesh;
+  c.skeleton = chain.skeleton;
+  c.weights.resize(chain.mesh.num_vertices(), 4);
+  for (Eigen::Index v = 0; v < chain.mesh.V.rows(); ++v) {  // j0, j1, j2 by height; j3 none
+    c.weights.insert(v, chain.mesh.V(v, 1) < 0.37 ? 0 : chain.mesh.V(v, 1) < 0.63 ? 1 : 2) = 1.0;
+  }
+  c.validate();
+  const predict::Prediction p = predictor.predict(c);
+  ASSERT_EQ(p.joint_weights.cols(), 4);
+  expect_rows_sum_to_one(Eigen::MatrixXd(p.joint_weights));
+  EXPECT_EQ(p.prepared.num_joints(), 4);
+  // the same prediction as for the input without weights: they do not steer it
+  geometry::Character bare = c;
+  bare.weights = geometry::SparseWeights();
+  EXPECT_EQ(Eigen::MatrixXd(predictor.predict(bare).joint_weights), Eigen::MatrixXd(p.joint_weights));
+  EXPECT_TRUE(predictor.compare(p).count("precision"));
+  // score (as the truth is prepared: j3 dropped) takes the prediction's 4 columns
+  EXPECT_TRUE(predictor.score(c, p.joint_weights).count("precision"));
 }
 
 TEST(Predictor, ModelDirectoryErrorsNameTheFile) {
