@@ -378,7 +378,9 @@ Command add_predict(CLI::App& app) {
   cmd->add_option("--rig", args->rig, "RigNet rig text file of an OBJ mesh (its skeleton; skin "
                                       "lines that do not fit the mesh are a warning)");
   cmd->add_option("--model", args->model,
-                  "run directory or bundled model (default: results/bundled/heterskinnet)");
+                  "run directory or bundled model (default: $SKINLAB_MODEL, else the model "
+                  "installed with the program, <prefix>/share/skinlab/models/heterskinnet, else "
+                  "in a build tree results/bundled/heterskinnet)");
   cmd->add_option("--checkpoint", args->checkpoint, "best or last (run directories)")
       ->capture_default_str();
   cmd->add_option("--out", args->out, "output file: .glb, .gltf, _rig.txt or .h5 (repeatable)");

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
 #include <climits>
 #include <ctime>
@@ -18,6 +19,9 @@
 
 #ifndef SKINLAB_SOURCE_DIR
 #error "SKINLAB_SOURCE_DIR must be defined by the build"
+#endif
+#if !defined(SKINLAB_BINARY_DIR) || !defined(SKINLAB_DATA_FROM_BIN)
+#error "SKINLAB_BINARY_DIR and SKINLAB_DATA_FROM_BIN must be defined by the build"
 #endif
 #ifndef SKINLAB_BUILD_TYPE
 #define SKINLAB_BUILD_TYPE "unknown"
@@ -54,6 +58,27 @@ std::string loaded_library(const std::string& soname) {
 }  // namespace
 
 std::filesystem::path source_dir() { return SKINLAB_SOURCE_DIR; }
+
+std::filesystem::path executable_path() {
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return ec ? std::filesystem::path() : exe;
+}
+
+bool running_from_build_tree() {
+  std::error_code ec;
+  const std::filesystem::path build = std::filesystem::canonical(SKINLAB_BINARY_DIR, ec);
+  if (ec) return false;
+  const std::filesystem::path exe = executable_path();
+  const auto [end, unused] = std::mismatch(build.begin(), build.end(), exe.begin(), exe.end());
+  return end == build.end();
+}
+
+std::filesystem::path installed_data_dir() {
+  const std::filesystem::path exe = executable_path();
+  if (exe.empty()) return {};
+  return (exe.parent_path() / SKINLAB_DATA_FROM_BIN / "skinlab").lexically_normal();
+}
 
 nlohmann::json git_json(const GitState& state) {
   nlohmann::json out = {{"git_commit", state.commit}, {"git_dirty", state.dirty}};

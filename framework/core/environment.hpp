@@ -69,7 +69,22 @@ std::string utc_time_text();
 /// command line.
 nlohmann::json collect_environment(std::uint64_t seed, const std::vector<std::string>& command);
 
-/// The source tree this binary was built from.
+/// The source tree this binary was built from. Only a program of that tree's own build directory
+/// (running_from_build_tree) may read files from it: an installed program must not.
 std::filesystem::path source_dir();
+
+/// The running program's own file (/proc/self/exe, symbolic links resolved); empty when it
+/// cannot be read.
+std::filesystem::path executable_path();
+
+/// Whether the running program lies inside the build directory it was compiled in (build/skinlab,
+/// the test and benchmark programs), so that the source tree beside it is the one it was built
+/// from. False for a program installed (`cmake --install`) or copied elsewhere.
+bool running_from_build_tree();
+
+/// `<directory of the program>/<bin-to-data>/skinlab`: where `cmake --install` puts skinlab's
+/// data, relative to the installed program (`<prefix>/bin/skinlab` → `<prefix>/share/skinlab`
+/// with the default GNUInstallDirs), so an installed prefix can be moved as a whole.
+std::filesystem::path installed_data_dir();
 
 }  // namespace skinlab

@@ -1,7 +1,9 @@
 #include "framework/predict/outputs.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
+#include <cstdlib>
 #include <vector>
 
 #include "framework/core/environment.hpp"
@@ -44,7 +46,40 @@ OutputKind output_kind(const fs::path& out) {
               "' (use .glb, .gltf, _rig.txt or .h5)");
 }
 
-fs::path default_model() { return source_dir() / "results" / "bundled" / "heterskinnet"; }
+fs::path default_model() {
+  const auto is_model = [](const fs::path& dir) { return fs::is_regular_file(dir / "config.yaml"); };
+  if (const char* env = std::getenv("SKINLAB_MODEL"); env != nullptr && *env != '\0') {
+    if (!is_model(env)) {
+      throw Error(std::string("SKINLAB_MODEL=") + env +
+                  ": not a model directory (no config.yaml); unset it to use the bundled model");
+    }
+    spdlog::info("model {} (SKINLAB_MODEL)", env);
+    return env;
+  }
+  std::vector<std::string> tried;
+  if (const fs::path data = installed_data_dir(); !data.empty()) {
+    const fs::path installed = data / "models" / "heterskinnet";
+    if (is_model(installed)) {
+      spdlog::info("model {} (installed with the program)", installed.string());
+      return installed;
+    }
+    tried.push_back(installed.string());
+  }
+  const bool build_tree = running_from_build_tree();
+  if (build_tree) {
+    const fs::path bundled = source_dir() / "results" / "bundled" / "heterskinnet";
+    if (is_model(bundled)) {
+      spdlog::info("model {} (the source tree of this build)", bundled.string());
+      return bundled;
+    }
+    tried.push_back(bundled.string());
+  }
+  std::string where;
+  for (const auto& dir : tried) where += (where.empty() ? "" : ", ") + dir;
+  throw Error("no model: give --model DIR or set SKINLAB_MODEL; the bundled model is not in " +
+              (where.empty() ? std::string("any place (the program's own path is unknown)") : where) +
+              (build_tree ? "" : " (a program outside its build tree does not use the source tree)"));
+}
 
 void write_prediction(const fs::path& out, const geometry::Character& input, const Prediction& p,
                       const Predictor& predictor, double prune) {

@@ -26,7 +26,14 @@ enum class OutputKind { gltf, rig, h5 };
 /// The kind of `out` by its extension; Error naming the file for any other.
 OutputKind output_kind(const std::filesystem::path& out);
 
-/// The bundled model of the source tree (results/bundled/heterskinnet).
+/// The model `predict` and `score` use without `--model`, the first that exists of:
+///   1. the directory in the environment variable SKINLAB_MODEL (an error when it is set but
+///      holds no model);
+///   2. the bundled model installed with the program: installed_data_dir() /
+///      models/heterskinnet (`<prefix>/share/skinlab/models/heterskinnet`, cmake --install);
+///   3. for a program of the build tree only (running_from_build_tree), the source tree's
+///      results/bundled/heterskinnet.
+/// None: an Error naming every place looked at. Logs (info) which one was taken.
 std::filesystem::path default_model();
 
 /// Writes prediction `p` of `input` to `out` (kind by extension). `prune` is recorded in .h5.

@@ -5,11 +5,8 @@
 
 #include <gtest/gtest.h>
 
-#include <cstdlib>
-#include <sstream>
-
-#include "framework/core/atomic_file.hpp"
 #include "framework/geometry/import_character.hpp"
+#include "tests/blender/blender_run.hpp"
 #include "tests/cli/cli_run.hpp"
 #include "tests/test_util.hpp"
 
@@ -19,6 +16,7 @@ namespace {
 using testing::Result;
 using testing::run;
 using testing::TempDir;
+using testing::value_of;
 
 // Blender 3.4's glTF importer still uses numpy.bool, which numpy 1.24 (Debian 12) removed.
 const char* kScript = R"(import numpy
@@ -42,15 +40,8 @@ print("MOST", most)
 print("WORST_SUM_ERROR", worst)
 )";
 
-std::string value_of(const std::string& out, const std::string& key) {
-  const auto at = out.find("\n" + key + " ");
-  if (at == std::string::npos) return "";
-  const auto start = at + key.size() + 2;
-  return out.substr(start, out.find('\n', start) - start);
-}
-
 TEST(Blender, ImportsThePredictedGlbWithAVertexGroupPerJoint) {
-  if (std::system("command -v blender > /dev/null 2>&1") != 0) {
+  if (!testing::blender_installed()) {
     GTEST_SKIP() << "blender is not installed (apt-get install blender python3-numpy)";
   }
   TempDir dir;
@@ -59,14 +50,9 @@ TEST(Blender, ImportsThePredictedGlbWithAVertexGroupPerJoint) {
   const Result p = run("predict " + horse.string() + " --out " + out.string());
   ASSERT_EQ(p.status, 0) << p.err;
   const auto script = dir.write("check.py", kScript);
-  const std::string command = "blender -b --factory-startup --python '" + script.string() +
-                              "' -- '" + out.string() + "' 2>&1";
-  FILE* pipe = ::popen(command.c_str(), "r");
-  ASSERT_NE(pipe, nullptr);
-  std::string text = "\n";
-  char buffer[4096];
-  while (std::fgets(buffer, sizeof buffer, pipe) != nullptr) text += buffer;
-  ASSERT_EQ(::pclose(pipe), 0) << text;
+  const testing::BlenderRun blender = testing::run_blender(script.string(), "'" + out.string() + "'");
+  const std::string& text = blender.text;
+  ASSERT_EQ(blender.status, 0) << text;
 
   geometry::ImportOptions o;
   o.join_identical_vertices = false;

@@ -20,18 +20,23 @@ struct Result {
   std::string err;
 };
 
-inline Result run(const std::string& args) {
+/// `command` through the shell, stdout and stderr captured apart.
+inline Result run_shell(const std::string& command) {
   TempDir dir;
   const auto err_file = dir / "stderr.txt";
-  const std::string command = std::string("cd '") + SKINLAB_SOURCE_DIR + "' && '" + SKINLAB_CLI +
-                              "' " + args + " 2>'" + err_file.string() + "'";
-  FILE* pipe = ::popen(command.c_str(), "r");
+  const std::string redirected = "(" + command + ") 2>'" + err_file.string() + "'";
+  FILE* pipe = ::popen(redirected.c_str(), "r");
   if (pipe == nullptr) throw std::runtime_error("popen failed");
   std::string out;
   std::array<char, 4096> buffer{};
   while (std::fgets(buffer.data(), buffer.size(), pipe) != nullptr) out += buffer.data();
   const int status = ::pclose(pipe);
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out, read_file(err_file)};
+}
+
+/// `skinlab <args>` run from the source directory, as a user runs it.
+inline Result run(const std::string& args) {
+  return run_shell(std::string("cd '") + SKINLAB_SOURCE_DIR + "' && '" + SKINLAB_CLI + "' " + args);
 }
 
 }  // namespace skinlab::testing
