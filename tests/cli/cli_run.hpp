@@ -1,5 +1,5 @@
 #pragma once
-// Runs the `skinlab` binary from the source directory, as a user runs it, and captures its exit
+// Runs the `skinlab` binary (or `skinlab-predict`) from the source directory, as a user runs it, and captures its exit
 // status, stdout and stderr (for the CLI tests).
 
 #include <sys/wait.h>
@@ -20,10 +20,11 @@ struct Result {
   std::string err;
 };
 
-inline Result run(const std::string& args) {
+/// Runs `binary` with `args` from the source directory.
+inline Result run_program(const std::string& binary, const std::string& args) {
   TempDir dir;
   const auto err_file = dir / "stderr.txt";
-  const std::string command = std::string("cd '") + SKINLAB_SOURCE_DIR + "' && '" + SKINLAB_CLI +
+  const std::string command = std::string("cd '") + SKINLAB_SOURCE_DIR + "' && '" + binary +
                               "' " + args + " 2>'" + err_file.string() + "'";
   FILE* pipe = ::popen(command.c_str(), "r");
   if (pipe == nullptr) throw std::runtime_error("popen failed");
@@ -33,5 +34,8 @@ inline Result run(const std::string& args) {
   const int status = ::pclose(pipe);
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out, read_file(err_file)};
 }
+
+/// Runs `skinlab` with `args`.
+inline Result run(const std::string& args) { return run_program(SKINLAB_CLI, args); }
 
 }  // namespace skinlab::testing
