@@ -11,6 +11,7 @@ set(SKINLAB_LAYERS
   "framework/geometry framework/binders"
   "framework/distances"
   "framework/data"
+  "framework/infer framework/predict_cli"
   "datasets baselines/bone_heat baselines/geo_voxel"
   "framework/tensors framework/graph framework/losses framework/models"
   "framework/task framework/train framework/eval framework/report framework/predict"

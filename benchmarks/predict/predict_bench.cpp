@@ -1,4 +1,5 @@
-// `skinlab predict` stage by stage (framework/predict/predictor.hpp) with the bundled model
+// `skinlab predict` stage by stage (framework/predict/predictor.hpp), and beside it the
+// Eigen-only `skinlab-predict` (infer/eigen_predictor.hpp, issue 24), with the bundled model
 // (results/bundled/heterskinnet, the paper's widths; SKINLAB_PREDICT_MODEL overrides the
 // directory) on synthetic characters of 1K, 3K and 5K vertices with 20 and 50 bones
 // (benchmarks/synthetic_body.hpp), at 1 and 2 threads (libtorch intra-op threads and TBB).
@@ -16,6 +17,11 @@
 // held before exec). BM_CliStartup is `skinlab --help`
 // (loading the shared libraries and their static initialisers, nothing of ours), and
 // BM_LoadModel the bundled model's loading in process.
+//
+// The `Eigen` twins run `skinlab-predict`'s forward pass on the bundle's parameters.h5 in the
+// same run: BM_EigenPredict in process, BM_EigenPredictCli the program (its --timings' model
+// loading in `model_s`, as BM_PredictCli's), BM_EigenCliStartup `skinlab-predict --help` and
+// BM_EigenLoadModel the loading of parameters.h5 and preparation.yaml in process.
 //
 // Like `skinlab` (framework/cli/main.cpp) the program keeps freed memory in the heap
 // (keep_freed_memory), so the in-process figures are those of the program.
@@ -45,6 +51,7 @@
 #include "framework/geometry/load_character.hpp"
 #include "framework/geometry/obj_io.hpp"
 #include "framework/geometry/rig_io.hpp"
+#include "framework/infer/eigen_predictor.hpp"
 #include "framework/predict/predictor.hpp"
 
 namespace {
@@ -88,6 +95,14 @@ const predict::Predictor* predictor() {
   return p.get();
 }
 
+const infer::EigenPredictor* eigen_predictor() {
+  static std::unique_ptr<infer::EigenPredictor> p;
+  if (!p && fs::exists(model_dir() / "parameters.h5")) {
+    p = std::make_unique<infer::EigenPredictor>(infer::EigenPredictor::load(model_dir()));
+  }
+  return p.get();
+}
+
 double peak_rss_mb() {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
@@ -124,11 +139,11 @@ bool run(benchmark::State& state, const std::string& command) {
   return true;
 }
 
-void BM_Predict(benchmark::State& state) {
+/// One whole prediction in process with `p` (libtorch's or the Eigen one).
+void predict_in_process(benchmark::State& state, const infer::PredictEngine* p) {
   const int size = static_cast<int>(state.range(0));
   const int bones = static_cast<int>(state.range(1));
   const int threads = static_cast<int>(state.range(2));
-  const predict::Predictor* p = predictor();
   if (p == nullptr) {
     state.SkipWithError(("no model in " + model_dir().string() +
                          " (skinlab bundle, or set SKINLAB_PREDICT_MODEL)").c_str());
@@ -177,43 +192,56 @@ void BM_Predict(benchmark::State& state) {
   state.counters["peak_rss_mb"] = peak_rss_mb();
 }
 
-/// The "peak memory N MiB" that `skinlab predict --timings` printed into `log`, or -1.
-double reported_peak_mib(const fs::path& log) {
+void BM_Predict(benchmark::State& state) { predict_in_process(state, predictor()); }
+void BM_EigenPredict(benchmark::State& state) { predict_in_process(state, eigen_predictor()); }
+
+/// The number after the last `key` ("peak memory ", "model loading ") in what `--timings`
+/// printed into `log`, or -1.
+double reported(const fs::path& log, const std::string& key) {
   std::ifstream in(log);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::string key = "peak memory ";
   const std::size_t at = text.rfind(key);
   return at == std::string::npos ? -1.0 : std::stod(text.substr(at + key.size()));
 }
 
-void BM_PredictCli(benchmark::State& state) {
+/// One process per iteration: `skinlab predict` or (`eigen`) `skinlab-predict`.
+void predict_program(benchmark::State& state, bool eigen) {
   const int size = static_cast<int>(state.range(0));
   const int bones = static_cast<int>(state.range(1));
   const int threads = static_cast<int>(state.range(2));
   const BodyFiles files(size, bones);
   const fs::path log = files.dir / "predict.log";
   const std::string command =
-      fmt::format("'{}' --threads {} --log-level warn predict '{}' --rig '{}' --model '{}' "
+      fmt::format("'{}' --threads {} --log-level warn {}'{}' --rig '{}' --model '{}' "
                   "--out '{}' --timings > '{}'",
-                  SKINLAB_BINARY, threads, files.obj.string(), files.rig.string(),
+                  eigen ? SKINLAB_PREDICT_BINARY : SKINLAB_BINARY, threads,
+                  eigen ? "" : "predict ", files.obj.string(), files.rig.string(),
                   model_dir().string(), files.out.string(), log.string());
-  double peak = 0;
+  double peak = 0, model = 0;
   for (auto _ : state) {
     if (!run(state, command)) return;
-    peak = std::max(peak, reported_peak_mib(log));
+    peak = std::max(peak, reported(log, "peak memory "));
+    model += reported(log, "model loading ");
   }
   state.counters["vertices"] = files.vertices;
   state.counters["bones"] = files.bones;
   state.counters["threads"] = threads;
   state.counters["peak_rss_mb"] = peak;
+  state.counters["model_s"] = model / static_cast<double>(state.iterations());
 }
 
-void BM_CliStartup(benchmark::State& state) {
-  const std::string command = fmt::format("'{}' --help > /dev/null", SKINLAB_BINARY);
+void BM_PredictCli(benchmark::State& state) { predict_program(state, false); }
+void BM_EigenPredictCli(benchmark::State& state) { predict_program(state, true); }
+
+void startup(benchmark::State& state, const char* binary) {
+  const std::string command = fmt::format("'{}' --help > /dev/null", binary);
   for (auto _ : state) {
     if (!run(state, command)) return;
   }
 }
+
+void BM_CliStartup(benchmark::State& state) { startup(state, SKINLAB_BINARY); }
+void BM_EigenCliStartup(benchmark::State& state) { startup(state, SKINLAB_PREDICT_BINARY); }
 
 void BM_LoadModel(benchmark::State& state) {
   for (auto _ : state) {
@@ -221,7 +249,18 @@ void BM_LoadModel(benchmark::State& state) {
   }
 }
 
+void BM_EigenLoadModel(benchmark::State& state) {
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(infer::EigenPredictor::load(model_dir()));
+  }
+}
+
 BENCHMARK(BM_Predict)
+    ->ArgsProduct({{0, 1, 2}, {20, 50}, {1, 2}})
+    ->ArgNames({"size", "bones", "threads"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_EigenPredict)
     ->ArgsProduct({{0, 1, 2}, {20, 50}, {1, 2}})
     ->ArgNames({"size", "bones", "threads"})
     ->Unit(benchmark::kMillisecond)
@@ -231,8 +270,15 @@ BENCHMARK(BM_PredictCli)
     ->ArgNames({"size", "bones", "threads"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+BENCHMARK(BM_EigenPredictCli)
+    ->ArgsProduct({{0, 1, 2}, {20, 50}, {1, 2}})
+    ->ArgNames({"size", "bones", "threads"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(BM_CliStartup)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_EigenCliStartup)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_LoadModel)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_EigenLoadModel)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 

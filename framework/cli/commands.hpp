@@ -31,6 +31,7 @@ Command add_figure(CLI::App& app);
 Command add_sweep(CLI::App& app);
 Command add_predict(CLI::App& app);
 Command add_bundle(CLI::App& app);
+Command add_export_parameters(CLI::App& app);
 Command add_export(CLI::App& app);
 Command add_score(CLI::App& app);
 /// Every task's own subcommands (framework/task/task.hpp, Task::commands).

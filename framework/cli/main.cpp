@@ -108,7 +108,8 @@ int main(int argc, char** argv) {
       skinlab::cli::add_train(app), skinlab::cli::add_eval(app),
       skinlab::cli::add_table(app), skinlab::cli::add_curves(app), skinlab::cli::add_figure(app),
       skinlab::cli::add_sweep(app), skinlab::cli::add_predict(app),
-      skinlab::cli::add_bundle(app), skinlab::cli::add_export(app),
+      skinlab::cli::add_bundle(app), skinlab::cli::add_export_parameters(app),
+      skinlab::cli::add_export(app),
       skinlab::cli::add_score(app)};
   try {  // the tasks' own commands: building the tasks can fail on a bad registration
     skinlab::verify_registries();

@@ -28,23 +28,15 @@
 #include "framework/data/dataset_file.hpp"
 #include "framework/data/h5.hpp"
 #include "framework/geometry/skin_weights.hpp"
+#include "framework/infer/map_back.hpp"
 
 namespace skinlab::eval {
 
-/// Rows of `W` (#V×C, prepared vertices) at the source vertices: row i of the result is row
-/// vertex_map[i]. Throws Error for a map entry outside [0, #V).
-data::RowMatrixXf to_source_vertices(const data::RowMatrixXf& W, const std::vector<int>& vertex_map);
-
-/// #V×#J joint weights from #V×#B bone weights: a bone's weight belongs to its start joint
-/// (RigNet; the inverse of the bone-level rule of data/preprocess.hpp). Exact zeros are not
-/// stored; each value is the float32 sum rounded to its shortest decimal form.
-geometry::SparseWeights joint_weights_of(const data::RowMatrixXf& W, const data::RowMatrixXi& bones,
-                                         int num_joints);
-
-/// The character's skeleton in its source file's frame (joint positions mapped through the
-/// inverse of PreparedCharacter::normalisation), with joint names made writable in a rig file:
-/// whitespace and '#' become '_', and a name that then collides gets a suffix `_2`, `_3`, ...
-geometry::Skeleton source_skeleton(const data::PreparedCharacter& character);
+// Mapping a prediction back to the source character (to_source_vertices, joint_weights_of,
+// source_skeleton) is torch-free and shared with the Eigen-only predictor: infer/map_back.hpp.
+using infer::joint_weights_of;
+using infer::source_skeleton;
+using infer::to_source_vertices;
 
 /// Writes the rig text of a prediction: `W_source` is #V_orig×#B bone weights at the source
 /// vertices (to_source_vertices).

@@ -63,19 +63,6 @@ WeightPair read_weights(const MetricInputs& in, const std::string& metric) {
   return {to_matrix(in.pred, context, "predicted"), to_matrix(in.target, context, "target")};
 }
 
-void prune_rows(RowMatrixXd& W, double fraction) {
-  TORCH_CHECK(fraction >= 0 && fraction <= 1, "prune_rows: fraction must be in [0, 1], got ",
-              fraction);
-  if (fraction == 0) return;
-  for (Eigen::Index v = 0; v < W.rows(); ++v) {
-    auto row = W.row(v);
-    const double cut = fraction * row.maxCoeff();
-    row = (row.array() < cut).select(0.0, row);
-    const double sum = row.sum();
-    if (sum > 0) row /= sum;
-  }
-}
-
 geometry::SparseWeights joint_weights(const RowMatrixXd& W, const RowMatrixXi& bones,
                                       int num_joints) {
   TORCH_CHECK(bones.cols() == 2 && bones.rows() == W.cols(), "joint_weights: bones are ",

@@ -10,6 +10,7 @@
 #include "framework/data/dataset_file.hpp"
 #include "framework/eval/metric.hpp"
 #include "framework/geometry/skin_weights.hpp"
+#include "framework/infer/map_back.hpp"
 
 namespace skinlab::eval {
 
@@ -33,14 +34,8 @@ WeightPair read_weights(const MetricInputs& in, const std::string& metric);
 /// "metric 'name'" or "metric 'name' (character 'c')": the prefix of every metric error.
 std::string error_context(const MetricInputs& in, const std::string& metric);
 
-/// Weight pruning of the compared methods (HeterSkinNet Sec. 4.5, "0.25 weight pruning
-/// threshold"; RigNet's run_skinning.py and Puppeteer's skinning/main.py do the same): in every
-/// row of W (#V×#B), weights below `fraction` × the row's maximum are set to 0 and the row is
-/// divided by its new sum (an all-zero row stays zero). `fraction` = 0 leaves W unchanged.
-/// Pruning is idempotent (kept weights stay above the threshold after renormalisation), so a
-/// prediction that a model has already pruned is not changed by a metric pruning it again.
-/// Requires 0 ≤ fraction ≤ 1.
-void prune_rows(RowMatrixXd& W, double fraction);
+/// The 0.25 pruning of HeterSkinNet Sec. 4.5 (infer/map_back.hpp, shared with prediction).
+using infer::prune_rows;
 
 /// #V×#J joint weights from #V×#B bone weights W. A bone moves with its start joint, so
 ///     W_J(v, j) = Σ_{b : bones(b, 0) = j} W(v, b),

@@ -17,8 +17,10 @@
 #include "framework/eval/evaluate.hpp"
 #include "framework/eval/predictions.hpp"
 #include "framework/eval/weights.hpp"
+#include "framework/infer/model_dir.hpp"
 #include "framework/geometry/weightless_leaves.hpp"
 #include "framework/models/model.hpp"
+#include "framework/predict/parameter_export.hpp"
 #include "framework/train/checkpoint.hpp"
 #include "framework/train/trainer.hpp"
 
@@ -27,64 +29,6 @@ namespace skinlab::predict {
 namespace fs = std::filesystem;
 
 using Clock = std::chrono::steady_clock;
-
-void check_predictable(const geometry::Character& c, const PredictOptions& options) {
-  const int nv = c.mesh.num_vertices();
-  if (nv > options.max_vertices) {
-    throw Error(fmt::format("{}: {} vertices, more than the limit of {} (max_vertices; the "
-                            "network's memory grows with #V: decimate the mesh, or raise the "
-                            "limit with --max-vertices)",
-                            c.name, nv, options.max_vertices));
-  }
-  if (nv == 0) throw Error(c.name + ": mesh has no vertices");
-  const Eigen::RowVector3d lo = c.mesh.V.colwise().minCoeff(), hi = c.mesh.V.colwise().maxCoeff();
-  const double diagonal = (hi - lo).norm();
-  const auto& s = c.skeleton;
-  for (int j = 0; j < s.num_joints(); ++j) {
-    const Eigen::RowVector3d p = s.positions.row(j);
-    const Eigen::RowVector3d outside = (lo - p).cwiseMax(p - hi).cwiseMax(0.0);
-    if (outside.norm() > options.max_joint_outside * diagonal) {
-      throw Error(fmt::format(
-          "{}: joint '{}' at ({:.4g}, {:.4g}, {:.4g}) lies {:.4g} outside the mesh's bounding "
-          "box [({:.4g}, {:.4g}, {:.4g}), ({:.4g}, {:.4g}, {:.4g})], more than {} of its "
-          "diagonal: the rig does not fit this mesh (units or frame?)",
-          c.name, s.names[j], p.x(), p.y(), p.z(), outside.norm(), lo.x(), lo.y(), lo.z(),
-          hi.x(), hi.y(), hi.z(), options.max_joint_outside));
-    }
-  }
-  if (s.num_joints() >= 2) {
-    const Eigen::RowVector3d first = s.positions.row(0);
-    double spread = 0;
-    for (int j = 1; j < s.num_joints(); ++j) {
-      spread = std::max(spread, (Eigen::RowVector3d(s.positions.row(j)) - first).norm());
-    }
-    if (!(spread > 1e-9 * std::max(diagonal, 1e-30))) {
-      throw Error(fmt::format("{}: all {} joints sit at one point ({:.4g}, {:.4g}, {:.4g}), so "
-                              "every bone has zero length and none gives a direction to skin "
-                              "along",
-                              c.name, s.num_joints(), first.x(), first.y(), first.z()));
-    }
-  }
-}
-
-std::string read_preparation(const fs::path& dir, const train::RunOptions& run) {
-  const fs::path own = dir / "preparation.yaml";
-  if (fs::exists(own)) return read_file(own);
-  if (run.data.file.empty()) {
-    throw IoError(dir.string() + ": no preparation.yaml and no data.file in config.yaml");
-  }
-  const fs::path data = run.data.file;
-  if (!fs::exists(data)) {
-    throw IoError(dir.string() + ": no preparation.yaml, and the run's dataset " + data.string() +
-                  " (data.file), whose preprocessing the model needs, does not exist; prepare "
-                  "it again or predict with a bundled model (skinlab bundle)");
-  }
-  const data::H5Reader reader(data);
-  if (!reader.has_attribute("/", "preparation")) {
-    throw IoError(data.string() + ": no 'preparation' attribute (written by skinlab prepare)");
-  }
-  return reader.read_attribute("/", "preparation");
-}
 
 Predictor Predictor::load(const fs::path& dir, const std::string& checkpoint) {
   const fs::path config_file = dir / "config.yaml";
@@ -111,20 +55,8 @@ Predictor Predictor::load(const fs::path& dir, const std::string& checkpoint) {
     }
   }
 
-  const std::string preparation_yaml = read_preparation(dir, p.options_);
-  const config::Config preparation =
-      config::Config::parse(preparation_yaml, (dir / "preparation.yaml").string());
-  p.preprocess_ = data::PreprocessOptions::from(preparation.root()["preprocess"]);
-  const config::Node distances = preparation.root()["distances"];
-  for (std::size_t i = 0; i < distances.size(); ++i) {
-    const config::Node node = distances[i];
-    if (node.required_type("distance") != p.options_.data.distance) continue;
-    p.distances_.push_back({p.options_.data.distance, distance_registry().create(node)});
-  }
-  if (p.distances_.empty()) {
-    throw ConfigError(dir.string() + ": the model reads distance '" + p.options_.data.distance +
-                      "', which its preparation does not list");
-  }
+  p.preparation_ = infer::parse_preparation(infer::read_preparation(dir, p.options_.data.file),
+                                            dir / "preparation.yaml", dir, p.options_.data.distance);
 
   p.model_ = train::build_model(p.options_);
   const train::TrainingState state = train::load_checkpoint(weights, *p.model_);
@@ -139,69 +71,20 @@ Predictor Predictor::load(const fs::path& dir, const std::string& checkpoint) {
 
 Prediction Predictor::predict(const geometry::Character& character, const PredictOptions& options,
                               StageTimes* times) const {
-  if (!(options.prune >= 0 && options.prune <= 1)) {
-    throw Error(fmt::format("prune must be in [0, 1], got {}", options.prune));
-  }
-  check_predictable(character, options);
-  datasets::SourceCharacter source;
-  source.character = character;
-  source.path = character.name;
-  source.up = options.up;
-  data::PreprocessMode mode;
-  mode.require_weights = false;
-  mode.laplacian = false;
-  data::PreprocessTimes pre;
-  Prediction out;
-  // The prediction does not depend on the input's weights: no weightless end joints are dropped
-  // (which ones are weightless is the input weights' word), so the prediction covers every joint
-  // of the input's skeleton, as the files it is written to do.
-  data::PreprocessOptions preprocess = preprocess_;
-  preprocess.drop_weightless_leaves = 0;
-  out.prepared = data::preprocess(source, distances_, preprocess, mode, &pre);
-  if (times != nullptr) {
-    times->normalise += pre.normalise;
-    times->distance += pre.distance;
-    times->graph += pre.graph;
-  }
-
-  auto start = Clock::now();
-  const data::DistanceData& d = out.prepared.distances.at(distance());
-  for (Eigen::Index v = 0; v < d.topk_distance.rows(); ++v) {
-    for (Eigen::Index k = 0; k < d.topk_distance.cols(); ++k) {
-      if (!std::isfinite(d.topk_distance(v, k))) {
-        throw Error(fmt::format("{}: vertex {} (of the prepared mesh) has no finite {} distance "
-                                "to candidate bone {}; cannot predict its weights",
-                                character.name, v, distance(), d.topk_index(v, k)));
-      }
-    }
-  }
-  const data::CharacterTensors c = data::to_tensors(out.prepared, distance());
+  data::PreparedCharacter prepared =
+      infer::prepare_to_predict(character, preparation_, options, times);
+  const auto start = Clock::now();
+  const data::CharacterTensors c = data::to_tensors(prepared, distance());
   torch::Tensor candidates;
   {
     torch::NoGradGuard no_grad;
     candidates = model_->forward(c);
   }
   train::check_prediction(candidates, c, options_);
-  const torch::Tensor scattered = data::scatter_to_bones(candidates, c.topk_index, c.num_bones());
-  data::RowMatrixXd W = eval::to_eigen(scattered).cast<double>();
-  eval::prune_rows(W, options.prune);
-  for (Eigen::Index v = 0; v < W.rows(); ++v) {
-    if (!(W.row(v).sum() > 0)) {
-      throw Error(fmt::format("{}: the network gave vertex {} (of the prepared mesh) no weight",
-                              character.name, v));
-    }
-  }
-  out.candidates = eval::to_eigen(candidates);
-  out.prepared_weights = W.cast<float>();
-  if (c.bone_weights.defined()) out.prepared_truth = eval::to_eigen(c.bone_weights);
+  data::RowMatrixXf output = eval::to_eigen(candidates);
   if (times != nullptr) times->network += seconds_since(start);
-
-  start = Clock::now();
-  out.source_weights = eval::to_source_vertices(out.prepared_weights, out.prepared.vertex_map);
-  out.joint_weights =
-      eval::joint_weights_of(out.source_weights, out.prepared.bones, out.prepared.num_joints());
-  if (times != nullptr) times->map_back += seconds_since(start);
-  return out;
+  return infer::finish_prediction(std::move(prepared), distance(), std::move(output), options.prune,
+                                  times);
 }
 
 std::map<std::string, double> Predictor::metrics_of(const torch::Tensor& pred,
@@ -247,8 +130,8 @@ std::map<std::string, double> Predictor::score(const geometry::Character& truth,
   // weights end joints (Blender does) would be prepared with more bones than the truth.
   geometry::Character base = truth;
   geometry::SparseWeights others = other;
-  data::PreprocessOptions preprocess = preprocess_;
-  if (data::drops_weightless_leaves(preprocess_, truth.name)) {
+  data::PreprocessOptions preprocess = preparation_.preprocess;
+  if (data::drops_weightless_leaves(preparation_.preprocess, truth.name)) {
     const std::vector<int> kept = geometry::drop_weightless_leaves(base);
     others = geometry::onto_kept_joints(other, truth.skeleton.parents, kept);
     preprocess.drop_weightless_leaves = 0;
@@ -259,12 +142,16 @@ std::map<std::string, double> Predictor::score(const geometry::Character& truth,
     source.character.weights = W;
     source.path = truth.name;
     source.up = options.up;
-    return data::preprocess(source, distances_, preprocess, mode);
+    return data::preprocess(source, preparation_.distances, preprocess, mode);
   };
   const data::PreparedCharacter t = prepare(base.weights);
   const data::PreparedCharacter o = prepare(others);
   return metrics_of(data::to_tensors(o, distance()).bone_weights,
                     data::to_tensors(t, distance()).bone_weights, t);
+}
+
+void Predictor::write_parameters(const fs::path& file) const {
+  write_parameter_file(file, *model_, options_, description_);
 }
 
 void bundle(const fs::path& run_dir, const fs::path& out, const std::string& checkpoint) {
@@ -276,7 +163,7 @@ void bundle(const fs::path& run_dir, const fs::path& out, const std::string& che
   }
   const train::RunOptions options = train::RunOptions::from(config::Config::load(config_file));
   if (!options.model.exists()) throw ConfigError(config_file.string() + ": no model section");
-  const std::string preparation = read_preparation(run_dir, options);
+  const std::string preparation = infer::read_preparation(run_dir, options.data.file);
 
   const std::shared_ptr<models::Model> model = train::build_model(options);
   const train::TrainingState state = train::load_checkpoint(weights, *model);
@@ -288,6 +175,9 @@ void bundle(const fs::path& run_dir, const fs::path& out, const std::string& che
     kept.torch_rng = torch::Tensor();
     kept.order_rng = torch::Tensor();
     train::save_checkpoint(staging / "model.pt", *model, nullptr, kept);
+    write_parameter_file(staging / "parameters.h5", *model, options,
+                         fmt::format("{} ({}.pt, epoch {})", run_dir.string(), checkpoint,
+                                     state.epoch));
     for (const auto& entry : fs::directory_iterator(run_dir)) {
       const std::string name = entry.path().filename().string();
       const bool provenance = name == "env.json" || name == "metrics.jsonl" ||

@@ -105,6 +105,21 @@ class Exchange(unittest.TestCase):
         try:
             os.environ["PATH"] = str(self.path)
             self.assertEqual(exchange.find_predictor(""), program)  # skinlab-predict on PATH
+            # With both on PATH: skinlab-predict, unless the model is a run it cannot read.
+            both = self.path / "both"
+            both.mkdir()
+            for name in ("skinlab", "skinlab-predict"):
+                (both / name).symlink_to(program)
+            os.environ["PATH"] = str(both)
+            self.assertEqual(exchange.find_predictor(""), str(both / "skinlab-predict"))
+            bundled = self.path / "bundled"
+            bundled.mkdir()
+            (bundled / "parameters.h5").write_bytes(b"")
+            self.assertEqual(exchange.find_predictor("", str(bundled)),
+                             str(both / "skinlab-predict"))
+            run = self.path / "run"
+            run.mkdir()
+            self.assertEqual(exchange.find_predictor("", str(run)), str(both / "skinlab"))
             os.environ["PATH"] = str(self.path / "empty")
             with self.assertRaisesRegex(PredictorError, "neither 'skinlab' nor 'skinlab-predict'"):
                 exchange.find_predictor("")

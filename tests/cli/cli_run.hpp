@@ -1,5 +1,5 @@
 #pragma once
-// Runs the `skinlab` binary from the source directory, as a user runs it, and captures its exit
+// Runs the `skinlab` binary (or `skinlab-predict`) from the source directory, as a user runs it, and captures its exit
 // status, stdout and stderr (for the CLI tests).
 
 #include <sys/wait.h>
@@ -34,9 +34,12 @@ inline Result run_shell(const std::string& command) {
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out, read_file(err_file)};
 }
 
-/// `skinlab <args>` run from the source directory, as a user runs it.
-inline Result run(const std::string& args) {
-  return run_shell(std::string("cd '") + SKINLAB_SOURCE_DIR + "' && '" + SKINLAB_CLI + "' " + args);
+/// Runs `binary` with `args` from the source directory, as a user runs it.
+inline Result run_program(const std::string& binary, const std::string& args) {
+  return run_shell(std::string("cd '") + SKINLAB_SOURCE_DIR + "' && '" + binary + "' " + args);
 }
+
+/// Runs `skinlab` with `args`.
+inline Result run(const std::string& args) { return run_program(SKINLAB_CLI, args); }
 
 }  // namespace skinlab::testing

@@ -7,8 +7,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -16,6 +18,7 @@
 #include "framework/data/h5.hpp"
 #include "framework/geometry/import_character.hpp"
 #include "framework/geometry/rig_io.hpp"
+#include "framework/infer/parameters.hpp"
 #include "tests/cli/cli_run.hpp"
 #include "tests/test_util.hpp"
 
@@ -77,7 +80,24 @@ struct BadCase {
   std::vector<std::string> expected;  ///< parts of the error line
 };
 
-TEST(PredictCli, EveryBadInputIsAOneLineErrorAndLeavesTheOutputAlone) {
+/// `skinlab predict ARGS` or `skinlab-predict ARGS`, and the start of their error lines.
+struct Program {
+  std::function<Result(const std::string&)> predict;
+  std::string error;
+};
+
+Program skinlab_predict() {
+  return {[](const std::string& args) { return run("predict " + args); }, "skinlab: error:"};
+}
+
+Program eigen_predict() {
+  return {[](const std::string& args) { return testing::run_program(SKINLAB_PREDICT_CLI, args); },
+          "skinlab-predict: error:"};
+}
+
+/// Every input of the bad corpus through `program`: one error line naming the file and the
+/// element, exit status 1, and the output file from an earlier run left as it was.
+void expect_every_bad_input_fails(const Program& program) {
   TempDir dir;
   // A 450×450 grid: 202,500 vertices, beyond the default --max-vertices.
   {
@@ -119,9 +139,9 @@ TEST(PredictCli, EveryBadInputIsAOneLineErrorAndLeavesTheOutputAlone) {
   const fs::path out = dir / "out.glb";
   for (const BadCase& c : cases) {
     write_file_atomic(out, "a good file from an earlier run");
-    const Result r = run("predict " + c.args + " --out " + out.string());
+    const Result r = program.predict(c.args + " --out " + out.string());
     EXPECT_EQ(r.status, 1) << c.args << "\n" << r.err;
-    const auto lines = error_lines(r.err);
+    const auto lines = lines_with(r.err, program.error, false);
     ASSERT_EQ(lines.size(), 1u) << c.args << "\n" << r.err;
     for (const auto& part : c.expected) {
       EXPECT_NE(lines[0].find(part), std::string::npos) << c.args << ": '" << part << "' not in\n"
@@ -131,6 +151,14 @@ TEST(PredictCli, EveryBadInputIsAOneLineErrorAndLeavesTheOutputAlone) {
     EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator()), 2)
         << c.args << ": a stray file was left";
   }
+}
+
+TEST(PredictCli, EveryBadInputIsAOneLineErrorAndLeavesTheOutputAlone) {
+  expect_every_bad_input_fails(skinlab_predict());
+}
+
+TEST(EigenPredictCli, EveryBadInputIsAOneLineErrorAndLeavesTheOutputAlone) {
+  expect_every_bad_input_fails(eigen_predict());
 }
 
 TEST(PredictCli, UsageErrorsComeBeforeAnyWork) {
@@ -430,6 +458,128 @@ TEST(PredictCli, BatchUsageErrorsComeBeforeAnyWork) {
     EXPECT_EQ(files_in(dir.path()), before) << c.args << ": something was written";
   }
   EXPECT_EQ(read_file(dir / "hero.glb"), "an input the batch must not overwrite");
+}
+
+/// Max abs difference of the dataset `name` of two .h5 predictions.
+double h5_difference(const fs::path& a, const fs::path& b, const std::string& name) {
+  const data::RowMatrixXd x = data::H5Reader(a).read_double(name);
+  const data::RowMatrixXd y = data::H5Reader(b).read_double(name);
+  EXPECT_EQ(x.rows(), y.rows()) << name;
+  EXPECT_EQ(x.cols(), y.cols()) << name;
+  if (x.rows() != y.rows() || x.cols() != y.cols()) return 1e30;
+  return (x - y).cwiseAbs().maxCoeff();
+}
+
+TEST(EigenPredictCli, WritesWhatSkinlabPredictWritesOneFileAndBatch) {
+  TempDir dir;
+  const std::vector<std::string> inputs = {kPlayer, kBad + "box.obj --rig " + kBad + "box_rig.txt"};
+  for (std::size_t k = 0; k < inputs.size(); ++k) {
+    const fs::path torch = dir / ("torch" + std::to_string(k) + ".h5");
+    const fs::path eigen = dir / ("eigen" + std::to_string(k) + ".h5");
+    const fs::path glb = dir / ("eigen" + std::to_string(k) + ".glb");
+    const Result t = run("predict " + inputs[k] + " --out " + torch.string());
+    ASSERT_EQ(t.status, 0) << t.err;
+    const Result e = testing::run_program(
+        SKINLAB_PREDICT_CLI, inputs[k] + " --timings --out " + eigen.string() + " --out " + glb.string());
+    ASSERT_EQ(e.status, 0) << e.err;
+    EXPECT_NE(e.out.find("stages (s): load"), std::string::npos) << e.out;
+    EXPECT_LE(h5_difference(torch, eigen, "weights"), 1e-5) << inputs[k];
+    EXPECT_LE(h5_difference(torch, eigen, "joint_weights"), 1e-5) << inputs[k];
+    EXPECT_EQ(data::H5Reader(torch).read_strings("joint_names"),
+              data::H5Reader(eigen).read_strings("joint_names"));
+    EXPECT_EQ(data::H5Reader(eigen).read_attribute("/", "distance"), "hollow_dist");
+    geometry::ImportOptions o;
+    o.join_identical_vertices = false;
+    const geometry::Character back = geometry::import_character(glb, o);
+    EXPECT_EQ(back.mesh.num_vertices(), data::H5Reader(eigen).read_double("weights").rows());
+  }
+
+  // Many inputs, one model load: the same summary and files as skinlab predict's.
+  const fs::path out = dir / "batch";
+  const Result b = testing::run_program(
+      SKINLAB_PREDICT_CLI, kPlayer + " " + kBad + "garbage.fbx " + kRigNet + " --out-dir " +
+                               out.string() + " --format rig");
+  EXPECT_EQ(b.status, 1) << b.err;
+  EXPECT_EQ(files_in(out), (std::vector<std::string>{"1347_remesh_rig.txt", "17872_remesh_rig.txt",
+                                                     "character_rig.txt"}));
+  EXPECT_NE(b.out.find("3 of 4 characters written to " + out.string()), std::string::npos) << b.out;
+  const auto errors = lines_with(b.err, "skinlab-predict: error:", false);
+  ASSERT_EQ(errors.size(), 1u) << b.err;
+  EXPECT_NE(errors[0].find("1 of 4 characters failed: " + kBad + "garbage.fbx"), std::string::npos)
+      << errors[0];
+}
+
+TEST(EigenPredictCli, BadParameterFileIsAnErrorNamingTheFileAndTheElement) {
+  TempDir dir;
+  const fs::path bundled = fs::path(SKINLAB_SOURCE_DIR) / "results" / "bundled" / "heterskinnet";
+  const infer::ParameterFile good = infer::read_parameter_file(bundled / "parameters.h5");
+  const fs::path model = dir / "model";
+  fs::create_directories(model);
+  for (const char* f : {"config.yaml", "preparation.yaml"}) fs::copy_file(bundled / f, model / f);
+  const fs::path file = model / "parameters.h5";
+  const fs::path out = dir / "out.glb";
+
+  struct Case {
+    std::string what;
+    std::function<void()> write;  ///< writes the bad parameters.h5 (or none)
+    std::vector<std::string> expected;
+  };
+  const auto with = [&](const std::function<void(infer::ParameterFile&)>& change) {
+    return [&, change] {
+      infer::ParameterFile p = good;
+      change(p);
+      infer::write_parameter_file(file, p);
+    };
+  };
+  const std::vector<Case> cases = {
+      {"missing", [] {}, {file.string(), "missing", "skinlab export-parameters"}},
+      {"garbage", [&] { write_file_atomic(file, "not an HDF5 file"); }, {file.string()}},
+      {"a NaN",
+       with([](infer::ParameterFile& p) {
+         p.parameters.at("head.linear0.weight").values[5] = std::nanf("");
+       }),
+       {file.string(), "parameter 'head.linear0.weight'", "element 5"}},
+      {"a missing parameter",
+       with([](infer::ParameterFile& p) { p.parameters.erase("stem.0_b2v.mlp.linear0.bias"); }),
+       {file.string(), "no parameter 'stem.0_b2v.mlp.linear0.bias'"}},
+      {"a wrong shape",
+       with([](infer::ParameterFile& p) {
+         auto& w = p.parameters.at("head.linear1.weight");
+         w.shape = {w.shape[1], w.shape[0]};
+       }),
+       {file.string(), "parameter 'head.linear1.weight' has shape [1024, 512], expected [512, 1024]"}},
+      {"an extra parameter",
+       with([](infer::ParameterFile& p) { p.parameters["spare.weight"] = {{1}, {0.5f}}; }),
+       {file.string(), "parameter 'spare.weight' is not used"}},
+      {"an op the Eigen pass lacks",
+       with([](infer::ParameterFile& p) { p.architecture["local"][2]["type"] = "gat_block"; }),
+       {file.string(), "op 'local.2_mesh_conv' (type gat_block) is not implemented"}},
+      {"another model",
+       with([](infer::ParameterFile& p) { p.model = "rignet_skin"; }),
+       {file.string(), "model 'rignet_skin' is not implemented"}},
+      {"a missing architecture field",
+       with([](infer::ParameterFile& p) { p.architecture.erase("top_k"); }),
+       {file.string(), "architecture", "'top_k'"}},
+  };
+  for (const Case& c : cases) {
+    fs::remove(file);
+    c.write();
+    const Result r = testing::run_program(SKINLAB_PREDICT_CLI, kBad + "box.obj --rig " + kBad +
+                                                                   "box_rig.txt --model " +
+                                                                   model.string() + " --out " +
+                                                                   out.string());
+    EXPECT_EQ(r.status, 1) << c.what << "\n" << r.err;
+    const auto lines = lines_with(r.err, "skinlab-predict: error:", false);
+    ASSERT_EQ(lines.size(), 1u) << c.what << "\n" << r.err;
+    for (const auto& part : c.expected) {
+      EXPECT_NE(lines[0].find(part), std::string::npos) << c.what << ": '" << part << "' not in\n"
+                                                        << lines[0];
+    }
+    EXPECT_FALSE(fs::exists(out)) << c.what;
+  }
+  EXPECT_EQ(files_in(model), (std::vector<std::string>{"config.yaml", "parameters.h5",
+                                                       "preparation.yaml"}))
+      << "no temporary file left beside the parameter file";
 }
 
 }  // namespace SKINLAB_UNITY_ID

@@ -7,6 +7,7 @@
 
 #include <limits>
 
+#include "framework/core/error.hpp"
 #include "framework/data/preprocess.hpp"
 #include "tests/eval/eval_fixtures.hpp"
 #include "tests/test_util.hpp"
@@ -45,7 +46,7 @@ TEST(PruneRows, ByHand) {
   EXPECT_EQ(unchanged, rows({{0.6, 0.3, 0.1}}));
   prune_rows(unchanged, 1.0);
   EXPECT_EQ(unchanged, rows({{1, 0, 0}}));
-  EXPECT_THROW(prune_rows(unchanged, 1.5), c10::Error);
+  EXPECT_THROW(prune_rows(unchanged, 1.5), skinlab::Error);  // infer/map_back.hpp
 }
 
 TEST(JointWeights, SumsTheBonesOfEachStartJoint) {

@@ -52,6 +52,19 @@ TEST(Install, AMovedPrefixPredictsWithItsOwnModel) {
   EXPECT_EQ(skinned.mesh.num_vertices(), geometry::read_obj(work / "box.obj").num_vertices());
   EXPECT_TRUE(skinned.has_weights());
 
+  // The program without libtorch finds the same installed model and writes the same joints.
+  const fs::path small = moved / "bin" / "skinlab-predict";
+  ASSERT_TRUE(fs::is_regular_file(small));
+  const Result q = run_shell("cd '" + work.string() + "' && env -u SKINLAB_MODEL '" +
+                             small.string() + "' --log-level info box.obj --out small.glb");
+  ASSERT_EQ(q.status, 0) << q.out << q.err;
+  EXPECT_NE(q.err.find("model " + model.string() + " (installed with the program)"), std::string::npos)
+      << q.err;
+  const geometry::Character small_skinned = geometry::import_character(work / "small.glb", keep);
+  EXPECT_EQ(small_skinned.mesh.num_vertices(), skinned.mesh.num_vertices());
+  EXPECT_EQ(small_skinned.skeleton.num_joints(), skinned.skeleton.num_joints());
+  EXPECT_TRUE(small_skinned.has_weights());
+
   // SKINLAB_MODEL is taken first.
   const fs::path other = dir / "other_model";
   fs::rename(model, other);

@@ -17,6 +17,7 @@
 #include "framework/geometry/import_character.hpp"
 #include "framework/geometry/obj_io.hpp"
 #include "framework/geometry/rig_io.hpp"
+#include "framework/infer/eigen_predictor.hpp"
 #include "framework/predict/predictor.hpp"
 #include "framework/train/checkpoint.hpp"
 #include "framework/train/trainer.hpp"
@@ -104,8 +105,8 @@ TEST(Predictor, RunDirectoryAndItsBundlePredictTheSameWeights) {
   EXPECT_NE(from_run.description().find("best.pt, epoch 7"), std::string::npos)
       << from_run.description();
   predict::bundle(run, dir / "bundle");
-  for (const char* f : {"config.yaml", "preparation.yaml", "model.pt", "eval_test.json",
-                        "source.txt"}) {
+  for (const char* f : {"config.yaml", "preparation.yaml", "model.pt", "parameters.h5",
+                        "eval_test.json", "source.txt"}) {
     EXPECT_TRUE(fs::exists(dir / "bundle" / f)) << f;
   }
   EXPECT_EQ(read_file(dir / "bundle" / "preparation.yaml"), kPreparation);
@@ -123,6 +124,12 @@ TEST(Predictor, RunDirectoryAndItsBundlePredictTheSameWeights) {
   const auto a = from_run.predict(c);
   const auto b = from_bundle.predict(c);
   EXPECT_EQ(a.source_weights, b.source_weights);
+  // The bundle's parameters.h5 runs without libtorch (skinlab-predict) to the same weights.
+  const auto eigen = infer::EigenPredictor::load(dir / "bundle");
+  EXPECT_NE(eigen.description().find("best.pt, epoch 7"), std::string::npos)
+      << eigen.description();
+  const auto e = eigen.predict(c);
+  EXPECT_LE((e.source_weights - b.source_weights).cwiseAbs().maxCoeff(), 1e-5);
 }
 
 TEST(Predictor, EveryVertexOfARealCharacterGetsWeightsOnItsCandidates) {

@@ -30,7 +30,7 @@ class SkinlabPreferences(bpy.types.AddonPreferences):
     predictor: bpy.props.StringProperty(
         name="Predictor",
         description="The predictor program: skinlab (run as 'skinlab predict') or "
-                    "skinlab-predict. Empty: the first of them on PATH",
+                    "skinlab-predict. Empty: skinlab-predict on PATH, else skinlab",
         subtype="FILE_PATH")
     model: bpy.props.StringProperty(
         name="Model",
@@ -204,7 +204,8 @@ class SKINLAB_OT_skin(bpy.types.Operator):
             armature = _armature_of(context, meshes)
             skeleton = Skeleton(armature, self.deform_only)
             program = exchange.find_predictor(
-                bpy.path.abspath(prefs.predictor) if prefs.predictor else "")
+                bpy.path.abspath(prefs.predictor) if prefs.predictor else "",
+                bpy.path.abspath(prefs.model) if prefs.model else "")
             # Every mesh is predicted and read back before any is changed.
             predicted = [(obj, _predict(obj, skeleton, prefs, program,
                                         os.path.join(workdir, f"mesh{k}")))

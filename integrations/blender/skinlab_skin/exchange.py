@@ -95,9 +95,11 @@ def read_weights(path, num_vertices, names):
     return weights
 
 
-def find_predictor(preference):
-    """The predictor program: the preference (a path, or a name on PATH), else `skinlab`, else
-    `skinlab-predict` on PATH."""
+def find_predictor(preference, model=""):
+    """The predictor program: the preference (a path, or a name on PATH), else from PATH
+    `skinlab-predict` (no libtorch: it starts in a tenth of the time) and then `skinlab`. A
+    `model` directory without parameters.h5 (a training run, not a bundled model) can only be
+    read by `skinlab`, so then `skinlab` comes first."""
     if preference:
         path = os.path.expanduser(preference)
         found = shutil.which(path)
@@ -105,7 +107,10 @@ def find_predictor(preference):
             raise PredictorError(f"the predictor '{preference}' (add-on preferences) is not an "
                                  "executable program")
         return found
-    for name in ("skinlab", "skinlab-predict"):
+    names = ["skinlab-predict", "skinlab"]
+    if model and not os.path.isfile(os.path.join(os.path.expanduser(model), "parameters.h5")):
+        names.reverse()
+    for name in names:
         found = shutil.which(name)
         if found is not None:
             return found

@@ -1,7 +1,7 @@
 #pragma once
 /// \file
-/// What `skinlab predict` writes and what `skinlab score` reads, as library code the program
-/// calls: a prediction written in the input's own frame, vertex order and joint names
+/// What `skinlab predict` and `skinlab-predict` write and what `skinlab score` reads, as
+/// library code both programs call (torch-free): a prediction written in the input's own frame, vertex order and joint names
 ///
 ///     .glb / .gltf   glTF 2.0 skin (geometry/gltf_export.hpp): joints, inverse bind matrices,
 ///                    JOINTS_0/WEIGHTS_0 with each vertex's 4 largest weights renormalised
@@ -17,28 +17,20 @@
 #include <string>
 
 #include "framework/geometry/load_character.hpp"
-#include "framework/predict/predictor.hpp"
+#include "framework/infer/prediction.hpp"
 
-namespace skinlab::predict {
+namespace skinlab::infer {
 
 enum class OutputKind { gltf, rig, h5 };
 
 /// The kind of `out` by its extension; Error naming the file for any other.
 OutputKind output_kind(const std::filesystem::path& out);
 
-/// The model `predict` and `score` use without `--model`, the first that exists of:
-///   1. the directory in the environment variable SKINLAB_MODEL (an error when it is set but
-///      holds no model);
-///   2. the bundled model installed with the program: installed_data_dir() /
-///      models/heterskinnet (`<prefix>/share/skinlab/models/heterskinnet`, cmake --install);
-///   3. for a program of the build tree only (running_from_build_tree), the source tree's
-///      results/bundled/heterskinnet.
-/// None: an Error naming every place looked at. Logs (info) which one was taken.
-std::filesystem::path default_model();
-
-/// Writes prediction `p` of `input` to `out` (kind by extension). `prune` is recorded in .h5.
+/// Writes prediction `p` of `input` to `out` (kind by extension). `model` (the model's
+/// description), `distance` and `prune` are recorded in .h5.
 void write_prediction(const std::filesystem::path& out, const geometry::Character& input,
-                      const Prediction& p, const Predictor& predictor, double prune);
+                      const Prediction& p, const std::string& model, const std::string& distance,
+                      double prune);
 
 /// Another method's weights on the joints of `truth`.
 struct OtherWeights {
@@ -53,4 +45,4 @@ struct OtherWeights {
 OtherWeights read_other_weights(const std::filesystem::path& file, const geometry::Character& truth,
                                 const std::string& truth_name, bool allow_unweighted);
 
-}  // namespace skinlab::predict
+}  // namespace skinlab::infer

@@ -1,35 +1,32 @@
-#include "framework/predict/outputs.hpp"
+#include "framework/infer/outputs.hpp"
 
 #include <fmt/format.h>
-#include <spdlog/spdlog.h>
 
-#include <cstdlib>
 #include <vector>
 
-#include "framework/core/environment.hpp"
 #include "framework/core/error.hpp"
 #include "framework/data/h5.hpp"
-#include "framework/eval/predictions.hpp"
 #include "framework/geometry/gltf_export.hpp"
 #include "framework/geometry/rig_io.hpp"
 #include "framework/geometry/vertex_normals.hpp"
+#include "framework/infer/map_back.hpp"
 
-namespace skinlab::predict {
+namespace skinlab::infer {
 
 namespace fs = std::filesystem;
 
 namespace {
 
-void write_h5(const fs::path& out, const geometry::Character& input,
-              const Prediction& p, const Predictor& predictor, double prune) {
+void write_h5(const fs::path& out, const geometry::Character& input, const Prediction& p,
+              const std::string& model, const std::string& distance, double prune) {
   data::H5Writer w(out);
   w.write("weights", p.source_weights);
   w.write("joint_weights", data::RowMatrixXd(Eigen::MatrixXd(p.joint_weights)));
   w.write("bones", p.prepared.bones);
   w.write_strings("joint_names", input.skeleton.names);
   w.write("vertices", data::RowMatrixXd(input.mesh.V));
-  w.write_attribute("model", predictor.description());
-  w.write_attribute("distance", predictor.distance());
+  w.write_attribute("model", model);
+  w.write_attribute("distance", distance);
   w.write_attribute("prune", fmt::format("{}", prune));
   w.write_attribute("character", input.name);
   w.commit();
@@ -46,43 +43,8 @@ OutputKind output_kind(const fs::path& out) {
               "' (use .glb, .gltf, _rig.txt or .h5)");
 }
 
-fs::path default_model() {
-  const auto is_model = [](const fs::path& dir) { return fs::is_regular_file(dir / "config.yaml"); };
-  if (const char* env = std::getenv("SKINLAB_MODEL"); env != nullptr && *env != '\0') {
-    if (!is_model(env)) {
-      throw Error(std::string("SKINLAB_MODEL=") + env +
-                  ": not a model directory (no config.yaml); unset it to use the bundled model");
-    }
-    spdlog::info("model {} (SKINLAB_MODEL)", env);
-    return env;
-  }
-  std::vector<std::string> tried;
-  if (const fs::path data = installed_data_dir(); !data.empty()) {
-    const fs::path installed = data / "models" / "heterskinnet";
-    if (is_model(installed)) {
-      spdlog::info("model {} (installed with the program)", installed.string());
-      return installed;
-    }
-    tried.push_back(installed.string());
-  }
-  const bool build_tree = running_from_build_tree();
-  if (build_tree) {
-    const fs::path bundled = source_dir() / "results" / "bundled" / "heterskinnet";
-    if (is_model(bundled)) {
-      spdlog::info("model {} (the source tree of this build)", bundled.string());
-      return bundled;
-    }
-    tried.push_back(bundled.string());
-  }
-  std::string where;
-  for (const auto& dir : tried) where += (where.empty() ? "" : ", ") + dir;
-  throw Error("no model: give --model DIR or set SKINLAB_MODEL; the bundled model is not in " +
-              (where.empty() ? std::string("any place (the program's own path is unknown)") : where) +
-              (build_tree ? "" : " (a program outside its build tree does not use the source tree)"));
-}
-
 void write_prediction(const fs::path& out, const geometry::Character& input, const Prediction& p,
-                      const Predictor& predictor, double prune) {
+                      const std::string& model, const std::string& distance, double prune) {
   geometry::Character result;
   result.name = input.name;
   result.mesh = input.mesh;
@@ -96,13 +58,13 @@ void write_prediction(const fs::path& out, const geometry::Character& input, con
       break;
     }
     case OutputKind::rig: {
-      geometry::Skeleton named = eval::source_skeleton(p.prepared);
+      geometry::Skeleton named = source_skeleton(p.prepared);
       named.positions = input.skeleton.positions;
       geometry::write_rig(out, named, p.joint_weights);
       break;
     }
     case OutputKind::h5:
-      write_h5(out, input, p, predictor, prune);
+      write_h5(out, input, p, model, distance, prune);
       break;
   }
 }
@@ -158,4 +120,4 @@ OtherWeights read_other_weights(const fs::path& file, const geometry::Character&
   return {mapped, unweighted};
 }
 
-}  // namespace skinlab::predict
+}  // namespace skinlab::infer

@@ -1,0 +1,104 @@
+#pragma once
+/// \file
+/// One prediction without the network: what `skinlab predict` (libtorch) and the Eigen-only
+/// `skinlab-predict` share around their forward passes, so both prepare a character, pick its
+/// candidate bones and map the weights back with the same code:
+///
+/// 1. check the character can be predicted for (size, joints inside the mesh, bones with
+///    length);
+/// 2. the training preprocessing on the fly (data/preprocess.hpp, HeterSkinNet Sec. 4.1:
+///    normalise, merge, subdivide; the model's distance and its top-K candidate bones, Sec. 3.2;
+///    one-ring and geodesic edges, Eq. 3), and a check that every candidate is at a finite
+///    distance;
+/// 3. the network's #V×K distribution over the candidates (the caller's forward pass);
+/// 4. scattered to #V×#B bone weights, pruned at 0.25 of the row maximum (Sec. 4.5), and mapped
+///    back to the input's own vertices and joints (infer/map_back.hpp).
+///
+/// Every vertex gets weights. The distances assign every vertex a finite distance to every
+/// bone (HollowDist restarts its search for parts the first search does not reach, HeterSkinNet
+/// Alg. 1; the other distances have their own rules), so every vertex has K candidates; a
+/// vertex whose candidate distances are not finite is an error naming the vertex, never a
+/// silent zero row.
+
+#include <string>
+#include <vector>
+
+#include "framework/data/dataset_file.hpp"
+#include "framework/data/preprocess.hpp"
+#include "framework/geometry/skin_weights.hpp"
+
+namespace skinlab::infer {
+
+/// Wall-clock seconds of the stages of one prediction (the benchmark's and `--timings`' rows).
+struct StageTimes {
+  double load = 0;       ///< reading the input file(s) and validating them
+  double normalise = 0;  ///< normalise, merge co-located vertices, subdivide
+  double distance = 0;   ///< vertex–bone distances and top-K candidates
+  double graph = 0;      ///< one-ring and geodesic edges
+  double network = 0;    ///< network input, forward pass, scatter and pruning
+  double map_back = 0;   ///< weights at the input's vertices and joints
+  double export_ = 0;    ///< writing the output file(s)
+  double total() const {
+    return load + normalise + distance + graph + network + map_back + export_;
+  }
+};
+
+struct PredictOptions {
+  /// Weights below this fraction of their row's maximum are dropped and the row renormalised
+  /// (HeterSkinNet Sec. 4.5's 0.25, the post-processing every compared method gets); 0 keeps
+  /// the network's raw distribution.
+  double prune = 0.25;
+  /// The input's up direction, rotated to +Y by the normalisation (geometry/normalize.hpp).
+  Eigen::Vector3d up = Eigen::Vector3d::UnitY();
+  /// Inputs with more vertices are refused: the network's memory grows linearly with #V (the
+  /// paper's characters have 1K–5K vertices; predict_bench measures the peak at 5K).
+  int max_vertices = 50000;
+  /// A joint farther than this fraction of the mesh's bounding-box diagonal outside that box is
+  /// an error: the rig and the mesh do not belong together (other units or another frame).
+  double max_joint_outside = 0.5;
+};
+
+/// Throws Error naming the character and the element when `character` cannot be predicted
+/// for: more than `options.max_vertices` vertices, a joint outside the mesh (see
+/// PredictOptions::max_joint_outside), or a skeleton of two or more joints that all sit at one
+/// point (every bone has zero length, so no bone has a direction to skin along). Mesh and
+/// skeleton validity (finite, in range, acyclic, one root) are checked when they are loaded.
+void check_predictable(const geometry::Character& character, const PredictOptions& options);
+
+struct Prediction {
+  data::PreparedCharacter prepared;      ///< normalised, merged, subdivided; weights if given
+  data::RowMatrixXf candidates;          ///< #V×K network output over prepared.topk_index
+  data::RowMatrixXf prepared_weights;    ///< #V×#B at the prepared vertices, pruned
+  data::RowMatrixXf source_weights;      ///< #V_in×#B at the input's vertices, pruned
+  geometry::SparseWeights joint_weights; ///< #V_in×#J per-joint weights at the input's vertices
+  /// #V×#B ground-truth bone weights at the prepared vertices when the input carried weights
+  /// (the bone-level rule of data/preprocess.hpp with the model's distance); 0×0 otherwise
+  data::RowMatrixXf prepared_truth;
+};
+
+/// The preprocessing a model was trained with: its dataset's `preprocess:` options and the one
+/// distance the model reads (`distance`, a registry key).
+struct Preparation {
+  data::PreprocessOptions preprocess;
+  std::vector<data::NamedDistance> distances;  ///< the one the model reads
+  const std::string& distance() const { return distances.front().type; }
+};
+
+/// Steps 1–2 of the file comment for `character` (its weights, if any, are ignored by the
+/// prediction and kept in the result for comparison). `times`, if given, receives normalise,
+/// distance and graph. Throws Error naming the character and the element.
+data::PreparedCharacter prepare_to_predict(const geometry::Character& character,
+                                           const Preparation& preparation,
+                                           const PredictOptions& options,
+                                           StageTimes* times = nullptr);
+
+/// Step 4: `candidates` (#V×K, the network's softmax over `prepared`'s candidates of
+/// `distance`) scattered to bones, pruned, checked (every vertex keeps a weight) and mapped
+/// back; `prepared` moves into the result. Throws Error naming `character_name` and the vertex
+/// for a non-finite or negative output or a vertex left without weight. `times->map_back`
+/// receives the mapping back.
+Prediction finish_prediction(data::PreparedCharacter prepared, const std::string& distance,
+                             data::RowMatrixXf candidates, double prune,
+                             StageTimes* times = nullptr);
+
+}  // namespace skinlab::infer
