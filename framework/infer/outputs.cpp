@@ -88,6 +88,11 @@ OtherWeights read_other_weights(const fs::path& file, const geometry::Character&
     other_skeleton = c.skeleton;
     other = c.weights;
   }
+  // A method that weighted no vertex at all (Blender's bone heat when it finds no solution for
+  // any bone) writes no skin line: with allow_unweighted every vertex predicts no bone.
+  if (other.rows() == 0 && allow_unweighted) {
+    other.resize(truth.mesh.num_vertices(), other_skeleton.num_joints());
+  }
   if (other.rows() != truth.mesh.num_vertices()) {
     throw Error(file.string() + ": no weights for the " + std::to_string(truth.mesh.num_vertices()) +
                 " vertices of " + truth_name);

@@ -269,6 +269,18 @@ TEST(PredictCli, GameCharacterExportedFromItsSourceIsSkinnedAndRendered) {
                              " vertices have no weight"),
             std::string::npos)
       << allowed.out;
+  // No skin line at all: with --allow-unweighted every vertex predicts no bone (recall 0).
+  const fs::path bare = dir / "bare_rig.txt";
+  geometry::write_rig(bare, artist.skeleton, {});
+  const Result none = run("score " + horse.string() + " --allow-unweighted --weights " + bare.string());
+  ASSERT_EQ(none.status, 0) << none.err;
+  EXPECT_NE(none.out.find(std::to_string(artist.mesh.num_vertices()) + " of " +
+                          std::to_string(artist.mesh.num_vertices()) + " vertices have no weight"),
+            std::string::npos)
+      << none.out;
+  EXPECT_NE(none.out.find("recall 0.0000"), std::string::npos) << none.out;
+  const Result bare_refused = run("score " + horse.string() + " --weights " + bare.string());
+  EXPECT_EQ(bare_refused.status, 1);
 
   const Result missing = run("export configs/datasets/zeroad_bundled.yaml unicorn --out " +
                              (dir / "u.glb").string());
