@@ -16,6 +16,9 @@ constexpr std::size_t kMeshSize = 24, kVertexArraySize = 20, kTriangleSize = 12,
 enum : std::uint32_t { kPosition = 0, kBlendIndexes = 4, kBlendWeights = 5 };
 enum : std::uint32_t { kUbyte = 1, kFloat = 7 };
 constexpr std::uint32_t kLoop = 1;
+/// At most this many pose transforms (frames × poses, over all clips: 512 MiB) are expanded;
+/// the largest of cube2-data's 99 IQM files (frankie/Frankie_Idle1.iqm) has 13364.
+constexpr std::uint64_t kMaxClipTransforms = std::uint64_t{1} << 22;
 
 std::string idx(const char* what, std::size_t i) {
   return std::string(what) + " " + std::to_string(i);
@@ -136,6 +139,8 @@ IqmFile read_iqm(std::string_view bytes, const std::string& source, bool read_cl
     }
   }
   const std::size_t nt = h.num_meshes > 0 ? h.num_triangles : 0;
+  r.require(h.ofs_triangles, nt * kTriangleSize,
+            "triangles (" + std::to_string(nt) + " in the header)");  // before allocating
   model.F.resize(static_cast<Eigen::Index>(nt), 3);
   for (std::size_t t = 0; t < nt; ++t) {
     const std::size_t o = h.ofs_triangles + kTriangleSize * t;
@@ -200,6 +205,8 @@ IqmFile read_iqm(std::string_view bytes, const std::string& source, bool read_cl
     std::uint32_t mask;
     float offset[10], scale[10];
   };
+  r.require(h.ofs_poses, std::size_t(h.num_poses) * kPoseSize,
+            "poses (" + std::to_string(h.num_poses) + " in the header)");  // before allocating
   std::vector<Pose> poses(h.num_poses);
   std::size_t channels = 0;
   for (std::uint32_t p = 0; p < h.num_poses; ++p) {
@@ -243,6 +250,7 @@ IqmFile read_iqm(std::string_view bytes, const std::string& source, bool read_cl
     }
     return out_frame;
   };
+  std::uint64_t transforms = 0;
   for (std::uint32_t a = 0; a < h.num_anims; ++a) {
     const std::size_t o = h.ofs_anims + kAnimSize * a;
     const std::string what = idx("animation", a);
@@ -256,6 +264,15 @@ IqmFile read_iqm(std::string_view bytes, const std::string& source, bool read_cl
       r.fail(o, what + " '" + clip.name + "'",
              "frames " + std::to_string(first) + "…" + std::to_string(first + count) +
                  " exceed the file's " + std::to_string(h.num_frames) + " frames");
+    }
+    // A frame stores 2 bytes per animated channel only, and clips may share frames, so the
+    // transforms the clips expand to are not bounded by the file's size.
+    transforms += count * h.num_poses;
+    if (transforms > kMaxClipTransforms) {
+      r.fail(o, what + " '" + clip.name + "'",
+             "the clips expand to more than " + std::to_string(kMaxClipTransforms) +
+                 " pose transforms (" + std::to_string(count) + " frames of " +
+                 std::to_string(h.num_poses) + " poses here), the reader's limit");
     }
     for (std::uint64_t f = first; f < first + count; ++f) {
       clip.local.push_back(frame_locals(static_cast<std::uint32_t>(f)));

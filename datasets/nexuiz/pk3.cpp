@@ -122,6 +122,13 @@ std::string ZipArchive::read(const Entry& e) const {
   if (e.method == 0) {
     out = std::move(data);
   } else {
+    // Deflate expands at most 1032:1 (zlib's technical notes), so a larger size is corrupt;
+    // checked before the output buffer is allocated.
+    if (e.size > std::uint64_t(e.compressed_size) * 1032 + 1032) {
+      throw IoError(what + ": uncompressed size " + std::to_string(e.size) +
+                    " is more than deflate can produce from " + std::to_string(e.compressed_size) +
+                    " bytes (corrupt size)");
+    }
     out.resize(e.size);
     z_stream z{};
     if (inflateInit2(&z, -MAX_WBITS) != Z_OK) throw IoError(what + ": inflateInit2 failed");

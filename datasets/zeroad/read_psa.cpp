@@ -21,6 +21,8 @@ Psa read_psa(const std::string& bytes, const std::string& source) {
   const std::uint32_t nb = r.u32("the bone count");
   const std::uint32_t nf = r.u32("the frame count");
   if (nb > 255) r.fail("bone count " + std::to_string(nb) + " exceeds 255");
+  // Frames of no bones take no bytes: their count would be bounded by nothing.
+  if (nb == 0 && nf > 0) r.fail(std::to_string(nf) + " frames of 0 bones");
   r.need_elements(nf, static_cast<std::size_t>(nb) * 28, "frame");
   psa.num_bones = static_cast<int>(nb);
   psa.frames.assign(nf, std::vector<Eigen::Isometry3d>(nb, Eigen::Isometry3d::Identity()));

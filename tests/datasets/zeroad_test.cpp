@@ -193,6 +193,18 @@ TEST(ZeroAdSkeletons, MalformedXmlNamesFileAndLine) {
       {"d.xml:1", "duplicate bone 'x'"}));
 }
 
+// A million nested elements (7 MB) overflowed the stack while the element tree was built and
+// destroyed recursively (found by a crafted input alongside the reader fuzzing; exit 139 of
+// `skinlab prepare`); nesting deeper than 256 is now rejected at the element that goes too deep.
+TEST(ZeroAdSkeletons, DeepNestingIsRejectedNotAStackOverflow) {
+  std::string xml = "<skeletons>\n";
+  for (int i = 0; i < 1000000; ++i) xml += "<b>";
+  for (int i = 0; i < 1000000; ++i) xml += "</b>";
+  xml += "</skeletons>\n";
+  EXPECT_TRUE(throws_with([&] { read_skeletons(xml, "deep.xml"); },
+                          {"deep.xml:2: <b>", "nested more than 256 deep"}));
+}
+
 TEST(ZeroAdActor, CollectsMeshesAnimationsAndVariants) {
   const ActorRefs refs = read_actor(
       "<actor version='1'><group><variant><mesh>skeletal/horse.dae</mesh></variant></group>"
