@@ -48,7 +48,9 @@ FigureRun open_run(const std::string& dir, const std::string& part) {
                               "--split {}` first)",
                               file.string(), part, dir, part));
   }
-  r.predictions = std::make_unique<data::H5Reader>(file);
+  r.predictions = std::make_unique<data::H5Reader>(
+      file, "written by an older skinlab: run `skinlab eval " + dir + " --split " + part +
+                "` again with this build");
   if (!r.predictions->has_attribute("/", "task") ||
       r.predictions->read_attribute("/", "task") != "corrective") {
     throw IoError(file.string() + ": not the predictions of a corrective evaluation (no "

@@ -349,18 +349,31 @@ Eigen::Isometry3d joint_transform(const float* m) {
   return out;
 }
 
-Dataset read_dataset(const std::filesystem::path& file) {
-  const H5Reader r(file);
-  if (!r.has_attribute("/", "format_version")) {
+std::unique_ptr<H5Reader> open_dataset_file(const std::filesystem::path& file) {
+  const std::string advice = "written by an older skinlab: re-run `skinlab prepare` with this build";
+  auto r = std::make_unique<H5Reader>(file, advice);
+  if (!r->has_attribute("/", "format_version")) {
     throw IoError(file.string() + ": not a skinlab dataset (no root attribute 'format_version')");
   }
-  const std::int64_t version = r.read_int_attribute("/", "format_version");
-  if (version < kOldestReadableFormatVersion || version > kFormatVersion) {
+  const std::int64_t version = r->read_int_attribute("/", "format_version");
+  if (version >= 1 && version < kFormatVersion) {
+    throw IoError(file.string() + ": written by an older skinlab (format_version " +
+                  std::to_string(version) + "; this build reads version " +
+                  std::to_string(kFormatVersion) +
+                  ", whose strings are fixed-length): re-run `skinlab prepare` on its dataset "
+                  "config to write it again");
+  }
+  if (version != kFormatVersion) {
     throw IoError(file.string() + ": format_version " + std::to_string(version) +
-                  " is not supported (this build reads versions " +
-                  std::to_string(kOldestReadableFormatVersion) + " to " +
+                  " is not supported (this build reads version " +
                   std::to_string(kFormatVersion) + ")");
   }
+  return r;
+}
+
+Dataset read_dataset(const std::filesystem::path& file) {
+  const std::unique_ptr<H5Reader> reader = open_dataset_file(file);
+  const H5Reader& r = *reader;
   Dataset d;
   d.git_commit = r.read_attribute("/", "skinlab_git_commit");
   d.preparation = r.read_attribute("/", "preparation");

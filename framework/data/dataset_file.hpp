@@ -23,11 +23,17 @@
 
 namespace skinlab::data {
 
-/// Version of the layout written by this build. Version 2 added the optional per-character
-/// `leaf_tips`; a version-1 file (which has none: zero-length helper bones) is still read, any
-/// other version is rejected.
-inline constexpr std::int64_t kFormatVersion = 2;
-inline constexpr std::int64_t kOldestReadableFormatVersion = 1;
+/// Version of the layout written by this build, the only one it reads. Version 2 added the
+/// optional per-character `leaf_tips`; version 3 stores every string fixed-length (versions 1
+/// and 2 hold variable-length strings in HDF5's global heap, on whose damage libhdf5 can hang,
+/// so they are refused with "re-run `skinlab prepare`").
+inline constexpr std::int64_t kFormatVersion = 3;
+
+/// Opens a dataset file and checks its root `format_version` (an int attribute, read before any
+/// string): IoError for a foreign file (none), an older version ("written by an older skinlab
+/// (format_version 2): re-run `skinlab prepare`") or a newer one. Every reader of a dataset file
+/// goes through this.
+std::unique_ptr<H5Reader> open_dataset_file(const std::filesystem::path& file);
 
 /// What one distance type gives a character (HeterSkinNet Sec. 3.2: the top-K candidate bones of
 /// every vertex and 1/D as a vertex attribute). K is min(top_k, #B).
@@ -129,7 +135,8 @@ void write_dataset(const std::filesystem::path& file, const Dataset& dataset,
 
 /// Reads and validates a dataset file. Throws IoError naming the file and the HDF5 path for: a
 /// missing file, a file that is not HDF5 or is truncated, a missing `format_version` (a foreign
-/// file) or a version other than kFormatVersion, a missing dataset, a wrong shape, an index out
+/// file) or a version other than kFormatVersion (open_dataset_file), a variable-length string,
+/// a missing dataset, a wrong shape, an index out
 /// of range (faces ≥ #V, bones or CSR columns ≥ #J, parents, top-K ≥ #B, edges, Laplacian,
 /// vertex map, split indices ≥ #characters), inconsistent CSR arrays, leaf tips that are not
 /// #J×3, and non-finite values.

@@ -48,6 +48,43 @@ std::size_t product(const std::vector<hsize_t>& dims) {
                          [](std::size_t a, hsize_t b) { return a * static_cast<std::size_t>(b); });
 }
 
+/// A fixed-length, null-padded UTF-8 string type of `width` bytes.
+H5::StrType fixed_string_type(std::size_t width) {
+  H5::StrType type(H5::PredType::C_S1, width);
+  type.setCset(H5T_CSET_UTF8);
+  type.setStrpad(H5T_STR_NULLPAD);
+  return type;
+}
+
+/// The most bytes a dataset or attribute of `file` can hold in memory: its file size times
+/// deflate's largest ratio (about 1:1032), plus 1 MiB. A damaged dataspace or datatype claiming
+/// more is rejected before anything is allocated (instead of std::bad_alloc, or minutes of
+/// zero-filling).
+std::size_t plausible_bytes(const std::filesystem::path& file) {
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(file, ec);
+  return (ec ? 0 : static_cast<std::size_t>(size)) * 1100 + (std::size_t{1} << 20);
+}
+
+/// prod(dims) × element_size, or throws IoError naming the file and `what` when it overflows or
+/// exceeds plausible_bytes.
+std::size_t checked_bytes(const std::filesystem::path& file, const std::string& what,
+                          const std::vector<hsize_t>& dims, std::size_t element_size) {
+  const std::size_t limit = plausible_bytes(file);
+  std::size_t bytes = std::max<std::size_t>(1, element_size);
+  for (const hsize_t d : dims) {
+    if (d != 0 && bytes > limit / static_cast<std::size_t>(d)) {
+      std::string shape;
+      for (const hsize_t e : dims) shape += (shape.empty() ? "" : "×") + std::to_string(e);
+      throw IoError(file.string() + ": " + what + " claims " + shape + " elements of " +
+                    std::to_string(element_size) +
+                    " bytes, more than the file can hold (damaged file)");
+    }
+    bytes *= static_cast<std::size_t>(d);
+  }
+  return bytes;
+}
+
 /// Chunked + deflate above kChunkThreshold: chunks span whole trailing dimensions and about
 /// 64 Ki elements of the first, so a reader of one row (one vertex) decompresses little.
 H5::DSetCreatPropList creation_properties(const std::vector<hsize_t>& dims, int level) {
@@ -121,6 +158,7 @@ std::vector<T> read_values(H5::H5File& file, const std::filesystem::path& path,
     if (cls != H5T_INTEGER && cls != H5T_FLOAT) {
       throw IoError(path.string() + ": dataset '" + name + "' is not numeric");
     }
+    checked_bytes(path, "dataset '" + name + "'", dims, std::max(sizeof(T), set.getDataType().getSize()));
     std::vector<T> values(product(dims));
     if (!values.empty()) set.read(values.data(), type);  // converts from the stored type
     if (dims_out != nullptr) dims_out->assign(dims.begin(), dims.end());
@@ -194,14 +232,27 @@ void H5Writer::write(const std::string& name, const std::vector<std::size_t>& di
 void H5Writer::write_strings(const std::string& name, const std::vector<std::string>& values) {
   try {
     ensure_groups(*file_, name, false);
-    H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);
-    type.setCset(H5T_CSET_UTF8);
+    // Fixed-length, null-padded, of the longest entry's size: variable-length strings would live
+    // in HDF5's global heap, whose reader (H5HG_read, libhdf5 1.10.8) loops forever on a damaged
+    // file. HDF5 has no zero-size string type, so the size is at least 1.
+    std::size_t width = 1;
+    for (const auto& v : values) width = std::max(width, v.size());
+    const H5::StrType type = fixed_string_type(width);
     const hsize_t dims[1] = {values.size()};
     H5::DataSpace space(1, dims);
-    H5::DataSet set = file_->createDataSet(name, type, space);
-    std::vector<const char*> pointers;
-    for (const auto& v : values) pointers.push_back(v.c_str());
-    if (!pointers.empty()) set.write(pointers.data(), type);
+    H5::DSetCreatPropList props;
+    if (deflate_level_ > 0 && values.size() * width >= kChunkThreshold * 4) {
+      const hsize_t chunk[1] = {std::max<hsize_t>(
+          1, std::min<hsize_t>(values.size(), 65536 / static_cast<hsize_t>(width)))};
+      props.setChunk(1, chunk);
+      props.setDeflate(static_cast<unsigned>(deflate_level_));
+    }
+    H5::DataSet set = file_->createDataSet(name, type, space, props);
+    std::string buffer(values.size() * width, '\0');
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      std::copy(values[i].begin(), values[i].end(), buffer.begin() + static_cast<long>(i * width));
+    }
+    if (!values.empty()) set.write(buffer.data(), type);
   } catch (const H5::Exception& e) {
     rethrow(out_.target(), "cannot write dataset '" + name + "'", e);
   }
@@ -222,11 +273,13 @@ void H5Writer::write_attribute(const std::string& name, const std::string& value
 void H5Writer::write_attribute(const std::string& object, const std::string& name,
                                const std::string& value) {
   try {
-    H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);  // h5py reads it as str
-    type.setCset(H5T_CSET_UTF8);
+    // Fixed-length of the value's own size (at least 1), never variable-length (write_strings).
+    const H5::StrType type = fixed_string_type(std::max<std::size_t>(1, value.size()));
     H5::Group group = open_or_create_group(*file_, object);
     H5::Attribute attr = group.createAttribute(name, type, H5::DataSpace(H5S_SCALAR));
-    attr.write(type, value);
+    std::string buffer = value;
+    buffer.resize(std::max<std::size_t>(1, value.size()), '\0');
+    attr.write(type, buffer.data());
   } catch (const H5::Exception& e) {
     rethrow(out_.target(), "cannot write attribute '" + name + "' of '" + object + "'", e);
   }
@@ -264,7 +317,8 @@ void H5Writer::commit() {
   out_.commit();
 }
 
-H5Reader::H5Reader(const std::filesystem::path& file) : path_(file) {
+H5Reader::H5Reader(const std::filesystem::path& file, std::string older_writer_advice)
+    : path_(file), older_writer_advice_(std::move(older_writer_advice)) {
   H5::Exception::dontPrint();
   if (!std::filesystem::exists(file)) throw IoError(file.string() + ": file does not exist");
   bool is_hdf5 = false;
@@ -345,23 +399,40 @@ std::vector<std::string> H5Reader::read_strings(const std::string& name) const {
     if (dims.size() != 1) {
       throw IoError(path_.string() + ": dataset '" + name + "' is not a 1-D list of strings");
     }
-    if (set.getTypeClass() != H5T_STRING || !set.getStrType().isVariableStr()) {
-      throw IoError(path_.string() + ": dataset '" + name +
-                    "' is not a list of variable-length strings");
+    if (set.getTypeClass() != H5T_STRING) {
+      throw IoError(path_.string() + ": dataset '" + name + "' is not a list of strings");
     }
-    H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);
-    type.setCset(set.getStrType().getCset());
-    std::vector<char*> buffer(dims[0], nullptr);
+    // Only the datatype is looked at: a variable-length string's data (in the global heap) is
+    // never read.
+    const H5::StrType stored = set.getStrType();
+    if (stored.isVariableStr()) variable_length("dataset '" + name + "'");
+    const std::size_t width = stored.getSize();
+    checked_bytes(path_, "dataset '" + name + "'", dims, width);
     std::vector<std::string> out;
-    if (buffer.empty()) return out;
+    if (dims[0] == 0) return out;
+    H5::StrType type(H5::PredType::C_S1, width);
+    type.setCset(stored.getCset());
+    type.setStrpad(H5T_STR_NULLPAD);
+    std::string buffer(static_cast<std::size_t>(dims[0]) * width, '\0');
     set.read(buffer.data(), type);
-    for (char* s : buffer) out.emplace_back(s == nullptr ? "" : s);
-    H5::DataSpace space = set.getSpace();
-    H5Dvlen_reclaim(type.getId(), space.getId(), H5P_DEFAULT, buffer.data());
+    out.reserve(static_cast<std::size_t>(dims[0]));
+    for (std::size_t i = 0; i < static_cast<std::size_t>(dims[0]); ++i) {
+      const std::string entry = buffer.substr(i * width, width);
+      out.push_back(entry.substr(0, entry.find('\0')));
+    }
     return out;
   } catch (const H5::Exception& e) {
     rethrow(path_, "cannot read dataset '" + name + "'", e);
   }
+}
+
+void H5Reader::variable_length(const std::string& what) const {
+  throw IoError(path_.string() + ": " + what + " holds variable-length strings, which skinlab " +
+                "no longer reads (libhdf5 can hang on a damaged global heap): " +
+                (older_writer_advice_.empty()
+                     ? std::string("written by an older skinlab or another program; write it "
+                                   "again with this build")
+                     : older_writer_advice_));
 }
 
 std::string H5Reader::read_attribute(const std::string& name) const {
@@ -393,27 +464,19 @@ std::string H5Reader::read_attribute(const std::string& object, const std::strin
       throw IoError(path_.string() + ": attribute '" + name + "' of '" + object +
                     "' is not a string");
     }
-    // Read through the C API: for a variable-length string whose stored pointer is null (a
-    // damaged file), HDF5's C++ Attribute::read calls strlen(nullptr) and crashes.
     const H5::StrType stored = attr.getStrType();
     if (attr.getSpace().getSimpleExtentNpoints() != 1) {
       throw IoError(path_.string() + ": attribute '" + name + "' of '" + object +
                     "' is not a single string");
     }
-    if (stored.isVariableStr()) {
-      H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);
-      type.setCset(stored.getCset());
-      char* text = nullptr;
-      if (H5Aread(attr.getId(), type.getId(), &text) < 0 || text == nullptr) {
-        throw IoError(path_.string() + ": attribute '" + name + "' of '" + object +
-                      "' cannot be read (damaged string)");
-      }
-      std::string value(text);
-      H5free_memory(text);
-      return value;
-    }
-    std::string buffer(stored.getSize(), '\0');
-    if (!buffer.empty() && H5Aread(attr.getId(), stored.getId(), buffer.data()) < 0) {
+    if (stored.isVariableStr()) variable_length("attribute '" + name + "' of '" + object + "'");
+    const std::size_t width = stored.getSize();
+    checked_bytes(path_, "attribute '" + name + "' of '" + object + "'", {1}, width);
+    H5::StrType type(H5::PredType::C_S1, width);
+    type.setCset(stored.getCset());
+    type.setStrpad(H5T_STR_NULLPAD);
+    std::string buffer(width, '\0');
+    if (!buffer.empty() && H5Aread(attr.getId(), type.getId(), buffer.data()) < 0) {
       throw IoError(path_.string() + ": attribute '" + name + "' of '" + object +
                     "' cannot be read");
     }
@@ -432,6 +495,10 @@ std::int64_t H5Reader::read_int_attribute(const std::string& object,
       throw IoError(path_.string() + ": attribute '" + name + "' of '" + object +
                     "' is not an integer");
     }
+    if (attr.getSpace().getSimpleExtentNpoints() != 1) {  // read() would write past `value`
+      throw IoError(path_.string() + ": attribute '" + name + "' of '" + object +
+                    "' is not a single value");
+    }
     std::int64_t value = 0;
     attr.read(H5::PredType::NATIVE_INT64, &value);
     return value;
@@ -447,6 +514,10 @@ double H5Reader::read_double_attribute(const std::string& object, const std::str
     if (attr.getTypeClass() != H5T_FLOAT && attr.getTypeClass() != H5T_INTEGER) {
       throw IoError(path_.string() + ": attribute '" + name + "' of '" + object +
                     "' is not a number");
+    }
+    if (attr.getSpace().getSimpleExtentNpoints() != 1) {  // read() would write past `value`
+      throw IoError(path_.string() + ": attribute '" + name + "' of '" + object +
+                    "' is not a single value");
     }
     double value = 0;
     attr.read(H5::PredType::NATIVE_DOUBLE, &value);

@@ -1,10 +1,14 @@
 #pragma once
 /// \file
 /// Small HDF5 layer over the C++ API: Eigen matrices as 2-D datasets (row-major on disk, so
-/// `h5dump` and h5py show them as they print), 1-D arrays, N-D float arrays, variable-length
-/// string lists, and (variable-length) string, integer and number attributes on any group. Groups
-/// are created by
-/// '/' in the name. Arrays of at least kChunkThreshold elements are chunked and
+/// `h5dump` and h5py show them as they print), 1-D arrays, N-D float arrays, string lists, and
+/// string, integer and number attributes on any group. Groups are created by '/' in the name.
+///
+/// Strings are fixed-length (null-padded UTF-8), never variable-length: variable-length data
+/// lives in HDF5's global heap, and libhdf5 1.10.8 loops forever in H5HG_read on a damaged one.
+/// The reader refuses a variable-length string by its datatype alone, before touching its data,
+/// so no file reaches the global heap through this layer. Sizes a damaged file claims are
+/// checked against the file's size before anything is allocated. Arrays of at least kChunkThreshold elements are chunked and
 /// deflate-compressed (gzip level 4, which h5py and h5dump read without plug-ins).
 ///
 /// Writes go to a temporary file renamed into place on `commit()`, so a crash never leaves a
@@ -57,12 +61,14 @@ class H5Writer {
   void write(const std::string& name, const std::vector<double>& values);
   /// Writes an N-D float32 dataset of shape `dims` from row-major `data` (prod(dims) values).
   void write(const std::string& name, const std::vector<std::size_t>& dims, const float* data);
-  /// Writes a 1-D dataset of variable-length UTF-8 strings.
+  /// Writes a 1-D dataset of fixed-length (the longest entry's size, at least 1) null-padded
+  /// UTF-8 strings; h5py reads them as `bytes` (`.asstr()` gives `str`).
   void write_strings(const std::string& name, const std::vector<std::string>& values);
   /// Creates a group (and its parents) if it does not exist.
   void create_group(const std::string& name);
 
-  /// Writes a string attribute on the root group (`name` without '/').
+  /// Writes a string attribute on the root group (`name` without '/'): a scalar fixed-length
+  /// null-padded UTF-8 string of the value's size (at least 1); h5py reads it as `bytes`.
   void write_attribute(const std::string& name, const std::string& value);
   /// Attributes on the group or dataset `object` ("/" for the root; groups are created).
   void write_attribute(const std::string& object, const std::string& name,
@@ -83,8 +89,10 @@ class H5Writer {
 class H5Reader {
  public:
   /// Opens `file` read-only. Throws IoError naming the file if it does not exist or is not an
-  /// HDF5 file (including a file truncated before its superblock).
-  explicit H5Reader(const std::filesystem::path& file);
+  /// HDF5 file (including a file truncated before its superblock). `older_writer_advice` ends
+  /// the error for a variable-length string (what an older skinlab wrote), e.g. "written by an
+  /// older skinlab: re-run `skinlab prepare`".
+  explicit H5Reader(const std::filesystem::path& file, std::string older_writer_advice = {});
   ~H5Reader();
   /// True if the link `name` exists (every group on the way must exist too).
   bool has(const std::string& name) const;
@@ -104,10 +112,10 @@ class H5Reader {
   /// Any-rank float dataset as row-major values; `dims` receives its shape.
   std::vector<float> read_float_array(const std::string& name,
                                       std::vector<std::size_t>& dims) const;
-  /// 1-D variable-length string dataset.
+  /// 1-D fixed-length string dataset; a variable-length one is an IoError (its data unread).
   std::vector<std::string> read_strings(const std::string& name) const;
 
-  /// String attribute on the root group.
+  /// String attribute on the root group (fixed-length; variable-length is an IoError).
   std::string read_attribute(const std::string& name) const;
   bool has_attribute(const std::string& object, const std::string& name) const;
   std::string read_attribute(const std::string& object, const std::string& name) const;
@@ -117,7 +125,10 @@ class H5Reader {
   const std::filesystem::path& path() const { return path_; }
 
  private:
+  [[noreturn]] void variable_length(const std::string& what) const;
+
   std::filesystem::path path_;
+  std::string older_writer_advice_;
   std::unique_ptr<H5::H5File> file_;
 };
 

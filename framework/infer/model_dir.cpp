@@ -11,6 +11,7 @@
 #include "framework/core/environment.hpp"
 #include "framework/core/error.hpp"
 #include "framework/core/registry.hpp"
+#include "framework/data/dataset_file.hpp"
 #include "framework/data/h5.hpp"
 
 namespace skinlab::infer {
@@ -64,11 +65,11 @@ std::string read_preparation(const fs::path& dir, const std::string& data_file) 
                   " (data.file), whose preprocessing the model needs, does not exist; prepare "
                   "it again or predict with a bundled model (skinlab bundle)");
   }
-  const data::H5Reader reader(data);
-  if (!reader.has_attribute("/", "preparation")) {
+  const std::unique_ptr<data::H5Reader> reader = data::open_dataset_file(data);
+  if (!reader->has_attribute("/", "preparation")) {
     throw IoError(data.string() + ": no 'preparation' attribute (written by skinlab prepare)");
   }
-  return reader.read_attribute("/", "preparation");
+  return reader->read_attribute("/", "preparation");
 }
 
 Preparation parse_preparation(const std::string& yaml, const fs::path& file, const fs::path& dir,

@@ -51,7 +51,21 @@ void write_parameter_file(const fs::path& file, const ParameterFile& p) {
 
 ParameterFile read_parameter_file(const fs::path& file) {
   if (!fs::exists(file)) throw IoError(file.string() + ": no such parameter file");
-  const data::H5Reader r(file);
+  // Version 1 stored its string attributes variable-length (in HDF5's global heap, which this
+  // build never reads): its format_version, an integer, is checked before any string.
+  const std::string older =
+      "written by an older skinlab (parameters format_version 1): re-run `skinlab "
+      "export-parameters` on its model with this build";
+  const data::H5Reader r(file, older);
+  if (r.has_attribute("/", "format_version")) {
+    const std::int64_t version = r.read_int_attribute("/", "format_version");
+    if (version >= 1 && version < kParameterFormatVersion) {
+      throw IoError(fmt::format("{}: written by an older skinlab (parameters format_version {}; "
+                                "this build reads version {}): re-run `skinlab "
+                                "export-parameters` on its model with this build",
+                                file.string(), version, kParameterFormatVersion));
+    }
+  }
   const auto attribute = [&](const char* name) {
     if (!r.has_attribute("/", name)) {
       throw IoError(fmt::format("{}: no attribute '{}' (not a parameter file of skinlab bundle "

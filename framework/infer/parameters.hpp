@@ -6,7 +6,7 @@
 ///
 ///     /                      attributes
 ///         format             "skinlab-parameters"
-///         format_version     1
+///         format_version     2 (1 stored its strings variable-length; refused: re-export)
 ///         model              the config's model type, e.g. "heterskinnet"
 ///         distance           the distance registry key the model reads, e.g. "hollow_dist"
 ///         source             where the parameters come from: "<run> (best.pt, epoch 35)"
@@ -21,6 +21,8 @@
 /// `{"name": "0_b2v", "type": "b2v", "mlp": [256]}`) and the op `global_branch`; and `mlps`,
 /// every MLP of the model by module path with its input width, layer widths and whether its
 /// last layer is activated (LeakyReLU(0.2) after every other layer, HeterSkinNet Sec. 4.2).
+/// The string attributes are fixed-length (data/h5.hpp: no variable-length data, so no damaged
+/// file reaches HDF5's global heap).
 
 #include <nlohmann/json.hpp>
 
@@ -33,7 +35,7 @@
 namespace skinlab::infer {
 
 inline constexpr const char* kParameterFormat = "skinlab-parameters";
-inline constexpr int kParameterFormatVersion = 1;
+inline constexpr int kParameterFormatVersion = 2;
 
 /// One parameter: its shape and its float32 values in row-major order.
 struct ParameterArray {

@@ -53,7 +53,9 @@ FigureRun open_run(const std::string& dir, const std::string& part) {
                     "--split {}` first)",
                     file.string(), part, dir, part));
   }
-  r.predictions = std::make_unique<data::H5Reader>(file);
+  r.predictions = std::make_unique<data::H5Reader>(
+      file, "written by an older skinlab: run `skinlab eval " + dir + " --split " + part +
+                "` again with this build");
   r.distance = r.predictions->read_attribute("/", "distance");
   if (root["metrics"].exists()) {
     for (const auto& m : eval::make_metrics(root["metrics"])) {

@@ -1,9 +1,11 @@
 #include "framework/train/checkpoint.hpp"
 
 #include <fmt/format.h>
+#include <zip.h>
 
 #include <cctype>
 #include <map>
+#include <memory>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -12,6 +14,45 @@
 #include "framework/core/error.hpp"
 
 namespace skinlab::train {
+
+namespace {
+
+/// Reads every entry of the zip archive `path` through libzip, which checks the central
+/// directory against the local headers (ZIP_CHECKCONS) and each entry's CRC-32, and throws
+/// IoError naming the file and the entry at the first damage. A checkpoint is a zip archive
+/// that libtorch trusts: a damaged one reaches its unpickler (and could crash it), so no byte
+/// goes to libtorch before this check.
+void check_zip_archive(const std::filesystem::path& path) {
+  const std::string where = path.string() + ": not a readable checkpoint (damaged zip archive";
+  int code = 0;
+  zip_t* archive = zip_open(path.c_str(), ZIP_RDONLY | ZIP_CHECKCONS, &code);
+  if (archive == nullptr) {
+    zip_error_t error;
+    zip_error_init_with_code(&error, code);
+    const std::string message = zip_error_strerror(&error);
+    zip_error_fini(&error);
+    throw IoError(where + ": " + message + ")");
+  }
+  const std::unique_ptr<zip_t, void (*)(zip_t*)> guard(archive, zip_discard);
+  const zip_int64_t entries = zip_get_num_entries(archive, 0);
+  std::vector<char> buffer(1 << 16);
+  for (zip_int64_t i = 0; i < entries; ++i) {
+    const char* name = zip_get_name(archive, static_cast<zip_uint64_t>(i), 0);
+    const std::string entry = name != nullptr ? name : "#" + std::to_string(i);
+    zip_file_t* file = zip_fopen_index(archive, static_cast<zip_uint64_t>(i), 0);
+    if (file == nullptr) {
+      throw IoError(where + ": entry '" + entry + "': " + zip_strerror(archive) + ")");
+    }
+    zip_int64_t got = 0;
+    while ((got = zip_fread(file, buffer.data(), buffer.size())) > 0) {
+    }
+    const std::string message = got < 0 ? zip_file_strerror(file) : "";
+    zip_fclose(file);
+    if (got < 0) throw IoError(where + ": entry '" + entry + "': " + message + ")");
+  }
+}
+
+}  // namespace
 
 std::filesystem::path checkpoint_file(const std::filesystem::path& run_dir,
                                       const std::string& which) {
@@ -160,6 +201,7 @@ TrainingState load_checkpoint(const fs::path& path, torch::nn::Module& model,
                               torch::optim::Optimizer* optimizer) {
   if (!fs::exists(path)) throw IoError(path.string() + ": checkpoint does not exist");
   const std::string where = path.string() + ": ";
+  check_zip_archive(path);
   torch::serialize::InputArchive archive;
   try {
     archive.load_from(path.string());
@@ -173,21 +215,21 @@ TrainingState load_checkpoint(const fs::path& path, torch::nn::Module& model,
     if (!archive.try_read(key, value)) throw IoError(where + "not a skinlab checkpoint (no '" + key + "')");
     return value;
   };
-  const std::int64_t version = read("version").toInt();
-  if (version != kCheckpointVersion) {
-    throw IoError(where + "checkpoint layout version " + std::to_string(version) +
-                  ", this build reads version " + std::to_string(kCheckpointVersion));
-  }
   TrainingState state;
-  state.model_config = read("model_config").toStringRef();
-  while (!state.model_config.empty() && std::isspace(static_cast<unsigned char>(state.model_config.back())))
-    state.model_config.pop_back();
-  const std::string difference = spec_difference(read("model_spec").toStringRef(), model);
-  if (!difference.empty()) {
-    throw IoError(where + "checkpoint does not match the model: " + difference +
-                  " (the checkpoint's model config: " + state.model_config + ")");
-  }
   try {
+    const std::int64_t version = read("version").toInt();
+    if (version != kCheckpointVersion) {
+      throw IoError(where + "checkpoint layout version " + std::to_string(version) +
+                    ", this build reads version " + std::to_string(kCheckpointVersion));
+    }
+    state.model_config = read("model_config").toStringRef();
+    while (!state.model_config.empty() && std::isspace(static_cast<unsigned char>(state.model_config.back())))
+      state.model_config.pop_back();
+    const std::string difference = spec_difference(read("model_spec").toStringRef(), model);
+    if (!difference.empty()) {
+      throw IoError(where + "checkpoint does not match the model: " + difference +
+                    " (the checkpoint's model config: " + state.model_config + ")");
+    }
     torch::serialize::InputArchive model_archive;
     archive.read("model", model_archive);
     model.load(model_archive);

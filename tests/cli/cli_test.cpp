@@ -143,7 +143,7 @@ TEST(Cli, PrepareAndDatasetInfoOnTheMinetestConfig) {
   const Result info = run("dataset-info " + out);
   ASSERT_EQ(info.status, 0) << info.err;
   for (const std::string part :
-       {"format_version 2", "characters: 1", "character: ", "168 original", "6 joints, 10 bones",
+       {"format_version 3", "characters: 1", "character: ", "168 original", "6 joints, 10 bones",
         "distances: euclidean (K=3), hollow_dist (K=3)", "skeleton minetest_player",
         "group character", "licence CC-BY-SA-3.0", "splits: 1", "random: train 1, val 0, test 0",
         "excluded: 0"}) {

@@ -58,25 +58,56 @@ TEST(DatasetFile, RoundTrip) {
   EXPECT_EQ(r.excluded[1].reason, "no bones");
 }
 
-TEST(DatasetFile, VersionOneFilesReadWithZeroLengthHelperBones) {
+/// What an older skinlab wrote: format_version `version`, a variable-length string attribute and
+/// a variable-length string list (their data in HDF5's global heap).
+void write_variable_length_file(const std::filesystem::path& file, std::int64_t version) {
+  H5::H5File f(file.string(), H5F_ACC_TRUNC);
+  f.createAttribute("format_version", H5::PredType::STD_I64LE, H5::DataSpace(H5S_SCALAR))
+      .write(H5::PredType::NATIVE_INT64, &version);
+  const H5::StrType vlen(H5::PredType::C_S1, H5T_VARIABLE);
+  f.createAttribute("skinlab_git_commit", vlen, H5::DataSpace(H5S_SCALAR))
+      .write(vlen, std::string("0123abcd"));
+  const hsize_t n[1] = {2};
+  const char* names[] = {"alpha", "beta"};
+  f.createDataSet("character_names", vlen, H5::DataSpace(1, n)).write(names, vlen);
+}
+
+TEST(DatasetFile, OlderVersionsAreRefusedWithReRunPrepare) {
   TempDir dir;
-  data::Dataset d = tiny_dataset();
-  d.characters[1].leaf_tips.resize(0, 0);
-  data::write_dataset(dir / "v1.h5", d);
-  {  // what a version-1 writer left: the same layout without leaf tips
-    H5::H5File file((dir / "v1.h5").string(), H5F_ACC_RDWR);
-    H5::Attribute version = file.openAttribute("format_version");
-    const std::int64_t one = 1;
-    version.write(H5::PredType::NATIVE_INT64, &one);
+  for (const std::int64_t version : {1, 2}) {
+    const auto file = dir / ("v" + std::to_string(version) + ".h5");
+    write_variable_length_file(file, version);
+    expect_error<IoError>(
+        [&] { data::read_dataset(file); },
+        {file.filename().string(),
+         "written by an older skinlab (format_version " + std::to_string(version),
+         "re-run `skinlab prepare`"});
   }
-  const auto r = data::read_dataset(dir / "v1.h5");
-  EXPECT_EQ(r.characters[1].leaf_tips.size(), 0);
-  const auto rig = r.characters[1].rig();
-  for (const auto& b : rig.bones()) {
-    if (b.helper) {
-      EXPECT_TRUE(rig.bone_end(b).isApprox(rig.positions.row(b.start).transpose()));
-    }
-  }
+}
+
+TEST(DatasetFile, VariableLengthStringsAreRefusedBeforeTheirDataIsRead) {
+  TempDir dir;
+  const auto file = dir / "vlen.h5";
+  write_variable_length_file(file, data::kFormatVersion);  // the current version, old strings
+  expect_error<IoError>([&] { data::read_dataset(file); },
+                        {"vlen.h5", "attribute 'skinlab_git_commit'", "variable-length strings",
+                         "re-run `skinlab prepare`"});
+  data::H5Reader r(file);
+  expect_error<IoError>([&] { r.read_strings("/character_names"); },
+                        {"vlen.h5", "dataset '/character_names'", "variable-length strings"});
+}
+
+TEST(DatasetFile, StringsAreFixedLength) {
+  TempDir dir;
+  data::write_dataset(dir / "d.h5", tiny_dataset());
+  H5::H5File file((dir / "d.h5").string(), H5F_ACC_RDONLY);
+  const H5::StrType names = file.openDataSet("/character_names").getStrType();
+  EXPECT_FALSE(names.isVariableStr());
+  EXPECT_EQ(names.getSize(), 5u);  // "alpha", the longest
+  const H5::StrType licence = file.openGroup("/characters/alpha").openAttribute("licence").getStrType();
+  EXPECT_FALSE(licence.isVariableStr());
+  EXPECT_EQ(licence.getSize(), 7u);  // "CC0-1.0"
+  EXPECT_EQ(licence.getCset(), H5T_CSET_UTF8);
 }
 
 TEST(DatasetFile, LeafTipsOfTheWrongShapeNameTheDataset) {
@@ -119,11 +150,11 @@ TEST(DatasetFile, ForeignAndBrokenFilesAreNamed) {
                         {"foreign.h5", "not a skinlab dataset", "format_version"});
   {
     data::H5Writer w(dir / "future.h5");
-    w.write_attribute("/", "format_version", std::int64_t{3});
+    w.write_attribute("/", "format_version", std::int64_t{4});
     w.commit();
   }
   expect_error<IoError>([&] { data::read_dataset(dir / "future.h5"); },
-                        {"future.h5", "format_version 3 is not supported", "versions 1 to 2"});
+                        {"future.h5", "format_version 4 is not supported", "reads version 3"});
 
   // Truncated: a real dataset cut at half its size (as a crash during a copy would leave it).
   data::Dataset d = tiny_dataset();
@@ -197,7 +228,7 @@ TEST(DatasetFile, ReadableByH5py) {
       "print(int(f.attrs['format_version']), names, c['V'].shape, c['F'][1].tolist(),\n"
       "      c['distances/euclidean/D'].shape, c['distances/euclidean/D'].compression,\n"
       "      np.allclose(rows, 1), list(f['splits/random/test'][()]),\n"
-      "      c.attrs['licence'], c['animations/0/frames'].shape)\n"
+      "      c.attrs['licence'].decode(), c['animations/0/frames'].shape)\n"
       "def generic(path):\n"
       "    p = path.split('/')\n"
       "    for i in range(len(p) - 1):\n"
@@ -229,7 +260,7 @@ TEST(DatasetFile, ReadableByH5py) {
   const std::string printed = read_file(out);
   ASSERT_EQ(status, 0) << printed;
   EXPECT_EQ(printed,
-            "2 ['alpha', 'beta'] (4, 3) [1, 3, 2] (4, 400) gzip True [1] CC0-1.0 (2, 3, 12)\n"
+            "3 ['alpha', 'beta'] (4, 3) [1, 3, 2] (4, 400) gzip True [1] CC0-1.0 (2, 3, 12)\n"
             // every table row of datasets/FORMAT.md, each read whole by h5py
             "attribute @format_version\n"
             "attribute @preparation\n"

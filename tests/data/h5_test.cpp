@@ -1,5 +1,6 @@
 #include "framework/data/h5.hpp"
 
+#include <H5Cpp.h>
 #include <gtest/gtest.h>
 
 #include "framework/core/error.hpp"
@@ -37,6 +38,51 @@ TEST(H5, RoundTripsMatricesGroupsAndAttributes) {
   EXPECT_EQ(r.read_attribute("distance"), "hollow_dist");
   expect_error<IoError>([&] { r.read_double("nope"); }, {"a.h5: no dataset 'nope'"});
   expect_error<IoError>([&] { r.read_attribute("nope"); }, {"no attribute 'nope'"});
+}
+
+TEST(H5, StringsRoundTripAsFixedLength) {
+  TempDir dir;
+  const std::vector<std::string> names = {"", "root", "Bip01 L Forearm", "\u00e9paule \u2192"};
+  std::vector<std::string> many;  // large enough to be chunked and compressed
+  for (int k = 0; k < 2000; ++k) many.push_back("reason " + std::to_string(k));
+  {
+    H5Writer w(dir / "s.h5");
+    w.write_strings("names", names);
+    w.write_strings("none", {});
+    w.write_strings("many", many);
+    w.write_attribute("/", "empty", std::string());
+    w.write_attribute("/", "text", std::string("line 1\nline 2 \u00e9"));
+    w.commit();
+  }
+  H5Reader r(dir / "s.h5");
+  EXPECT_EQ(r.read_strings("names"), names);
+  EXPECT_TRUE(r.read_strings("none").empty());
+  EXPECT_EQ(r.read_strings("many"), many);
+  EXPECT_EQ(r.read_attribute("/", "empty"), "");
+  EXPECT_EQ(r.read_attribute("/", "text"), "line 1\nline 2 \u00e9");
+}
+
+TEST(H5, SizesAFileCannotHoldAreRejectedBeforeReading) {
+  TempDir dir;
+  {
+    H5Writer w(dir / "big.h5");
+    // 2^20 × 2^20 floats (4 TiB) claimed by a dataspace whose data was never written: what a
+    // damaged dataspace looks like to the reader.
+    w.write("small", std::vector<float>{1, 2});
+    w.commit();
+  }
+  {
+    const hid_t f = H5Fopen((dir / "big.h5").c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    const hsize_t dims[2] = {hsize_t{1} << 20, hsize_t{1} << 20};
+    const hid_t space = H5Screate_simple(2, dims, nullptr);
+    const hid_t set = H5Dcreate2(f, "huge", H5T_NATIVE_FLOAT, space, H5P_DEFAULT, H5P_DEFAULT,
+                                 H5P_DEFAULT);
+    H5Dclose(set);
+    H5Sclose(space);
+    H5Fclose(f);
+  }
+  expect_error<IoError>([&] { H5Reader(dir / "big.h5").read_float("huge"); },
+                        {"big.h5", "dataset 'huge'", "1048576×1048576", "more than the file can hold"});
 }
 
 TEST(H5, UncommittedWriteLeavesTheOldFile) {

@@ -1,4 +1,4 @@
-// The inputs the reader fuzzing found bugs with (tests/data/fuzz_regressions/<target>/, one
+// The inputs the reader fuzzing found bugs with (tests/data/fuzz_regressions/readers/<target>/, one
 // directory per reader target of reader_targets.hpp), fed to their reader in the fast suite:
 // each must be accepted or rejected with skinlab::Error, never crash, hang or throw anything
 // else. docs/development.md ("Fuzzing") lists what each one found.
@@ -15,7 +15,7 @@ namespace {
 namespace SKINLAB_UNITY_ID {
 
 TEST(FuzzRegressions, EveryKeptInputIsAcceptedOrRejectedWithAnError) {
-  const fs::path root = fs::path(SKINLAB_SOURCE_DIR) / "tests/data/fuzz_regressions";
+  const fs::path root = fs::path(SKINLAB_SOURCE_DIR) / "tests/data/fuzz_regressions/readers";
   std::map<std::string, ReaderTarget> targets;
   for (ReaderTarget& t : reader_targets()) targets.emplace(t.name, std::move(t));
   std::set<fs::path> dirs;

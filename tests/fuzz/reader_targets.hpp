@@ -1,6 +1,6 @@
 #pragma once
 // The binary and XML game-file readers of datasets/ as fuzz targets: for each, its name (also
-// the directory of its regression inputs, tests/data/fuzz_regressions/<name>/), its seed files
+// the directory of its regression inputs, tests/data/fuzz_regressions/readers/<name>/), its seed files
 // (small files committed under datasets/*/bundled/) and a `parse(bytes, file)` that runs the
 // reader, and what a builder computes right after it, on one input. A call returns when the
 // input is accepted and throws skinlab::Error when it is rejected; anything else is a finding.

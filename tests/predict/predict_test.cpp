@@ -12,6 +12,7 @@
 #include "framework/core/atomic_file.hpp"
 #include "framework/core/config.hpp"
 #include "framework/core/error.hpp"
+#include "framework/data/dataset_file.hpp"
 #include "framework/data/h5.hpp"
 #include "framework/geometry/gltf_export.hpp"
 #include "framework/geometry/import_character.hpp"
@@ -70,7 +71,8 @@ fs::path write_run(const TempDir& dir, const std::string& preparation = kPrepara
   const std::string data = (dir / "data.h5").string();
   config.replace(config.find("unused.h5"), 9, data);
   write_file_atomic(run / "config.yaml", config);
-  data::H5Writer h5(data);
+  data::H5Writer h5(data);  // a dataset file as far as the model directory reads one
+  h5.write_attribute("/", "format_version", data::kFormatVersion);
   h5.write_attribute("preparation", preparation);
   h5.commit();
   const train::RunOptions options = train::RunOptions::from(config::Config::parse(config));
