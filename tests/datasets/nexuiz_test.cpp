@@ -2,7 +2,6 @@
 // (nexuiz-data, GPL-2+; datasets/nexuiz/bundled/LICENSE.md).
 
 #include <gtest/gtest.h>
-#include <zlib.h>
 
 #include <algorithm>
 #include <fstream>
@@ -13,6 +12,7 @@
 #include "datasets/nexuiz/zym.hpp"
 #include "framework/core/registry.hpp"
 #include "framework/geometry/lbs.hpp"
+#include "tests/datasets/zip_writer.hpp"
 #include "tests/test_util.hpp"
 
 namespace skinlab::datasets {
@@ -29,44 +29,7 @@ std::vector<Eigen::Affine3d> skinning_transforms(const Transforms& frame, const 
   return T;
 }
 
-/// A zip archive of (name, bytes, deflate?) members, written as APPNOTE.TXT says.
-std::string make_zip(const std::vector<std::tuple<std::string, std::string, bool>>& members) {
-  std::string out, central;
-  auto u16 = [](std::string& s, unsigned v) { s += char(v & 0xff), s += char((v >> 8) & 0xff); };
-  auto u32 = [&](std::string& s, std::uint32_t v) { u16(s, v & 0xffff), u16(s, v >> 16); };
-  for (const auto& [name, data, deflate] : members) {
-    std::string stored = data;
-    if (deflate) {
-      z_stream z{};
-      deflateInit2(&z, 9, Z_DEFLATED, -MAX_WBITS, 8, Z_DEFAULT_STRATEGY);
-      stored.resize(deflateBound(&z, data.size()));
-      z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data.data()));
-      z.avail_in = static_cast<uInt>(data.size());
-      z.next_out = reinterpret_cast<Bytef*>(stored.data());
-      z.avail_out = static_cast<uInt>(stored.size());
-      EXPECT_EQ(::deflate(&z, Z_FINISH), Z_STREAM_END);
-      stored.resize(z.total_out);
-      deflateEnd(&z);
-    }
-    const auto crc = static_cast<std::uint32_t>(
-        crc32(0, reinterpret_cast<const Bytef*>(data.data()), static_cast<uInt>(data.size())));
-    const auto offset = static_cast<std::uint32_t>(out.size());
-    std::string common;
-    u16(common, 20), u16(common, 0), u16(common, deflate ? 8 : 0), u16(common, 0), u16(common, 0);
-    u32(common, crc), u32(common, stored.size()), u32(common, data.size());
-    u16(common, name.size()), u16(common, 0);
-    u32(out, 0x04034b50), out += common, out += name, out += stored;
-    u32(central, 0x02014b50), u16(central, 20), central += common;
-    u16(central, 0), u16(central, 0), u16(central, 0), u32(central, 0), u32(central, offset);
-    central += name;
-  }
-  const auto cd_offset = static_cast<std::uint32_t>(out.size());
-  out += central;
-  u32(out, 0x06054b50), u16(out, 0), u16(out, 0), u16(out, members.size()),
-      u16(out, members.size());
-  u32(out, central.size()), u32(out, cd_offset), u16(out, 0);
-  return out;
-}
+using testing::make_zip;
 
 TEST(Zym, ReadsMarineCountsNamesAndRigidWeights) {
   const nexuiz::ZymFile zym = nexuiz::read_zym_file(kModel);

@@ -6,8 +6,6 @@
 // input is accepted and throws skinlab::Error when it is rejected; anything else is a finding.
 // Used by readers_fuzz_test.cpp (label long) and fuzz_regressions_test.cpp (label fast).
 
-#include <zlib.h>
-
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -24,9 +22,12 @@
 #include "datasets/zeroad/read_pmd.hpp"
 #include "datasets/zeroad/read_psa.hpp"
 #include "datasets/zeroad/read_skeletons.hpp"
+#include "tests/datasets/zip_writer.hpp"
 #include "tests/fuzz/fuzz_harness.hpp"
 
 namespace skinlab::fuzz {
+
+using testing::make_zip;
 
 struct ReaderTarget {
   std::string name;
@@ -39,45 +40,6 @@ inline std::string bundled(const std::string& path) {
   return read_bytes(fs::path(SKINLAB_SOURCE_DIR) / "datasets" / path);
 }
 
-/// A zip archive of (name, bytes, deflate?) members, written as APPNOTE.TXT says (the pk3
-/// target's seed: no zip is committed under datasets/).
-inline std::string make_zip(const std::vector<std::tuple<std::string, std::string, bool>>& members) {
-  std::string out, central;
-  auto u16 = [](std::string& s, unsigned v) { s += char(v & 0xff), s += char((v >> 8) & 0xff); };
-  auto u32 = [&](std::string& s, std::uint32_t v) { u16(s, v & 0xffff), u16(s, v >> 16); };
-  for (const auto& [name, data, deflate] : members) {
-    std::string stored = data;
-    if (deflate) {
-      z_stream z{};
-      deflateInit2(&z, 9, Z_DEFLATED, -MAX_WBITS, 8, Z_DEFAULT_STRATEGY);
-      stored.resize(deflateBound(&z, data.size()));
-      z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data.data()));
-      z.avail_in = static_cast<uInt>(data.size());
-      z.next_out = reinterpret_cast<Bytef*>(stored.data());
-      z.avail_out = static_cast<uInt>(stored.size());
-      if (::deflate(&z, Z_FINISH) != Z_STREAM_END) throw std::runtime_error("deflate failed");
-      stored.resize(z.total_out);
-      deflateEnd(&z);
-    }
-    const auto crc = static_cast<std::uint32_t>(
-        crc32(0, reinterpret_cast<const Bytef*>(data.data()), static_cast<uInt>(data.size())));
-    const auto offset = static_cast<std::uint32_t>(out.size());
-    std::string common;
-    u16(common, 20), u16(common, 0), u16(common, deflate ? 8 : 0), u16(common, 0), u16(common, 0);
-    u32(common, crc), u32(common, stored.size()), u32(common, data.size());
-    u16(common, name.size()), u16(common, 0);
-    u32(out, 0x04034b50), out += common, out += name, out += stored;
-    u32(central, 0x02014b50), u16(central, 20), central += common;
-    u16(central, 0), u16(central, 0), u16(central, 0), u32(central, 0), u32(central, offset);
-    central += name;
-  }
-  const auto cd_offset = static_cast<std::uint32_t>(out.size());
-  out += central;
-  u32(out, 0x06054b50), u16(out, 0), u16(out, 0), u16(out, members.size()),
-      u16(out, members.size());
-  u32(out, central.size()), u32(out, cd_offset), u16(out, 0);
-  return out;
-}
 
 inline std::vector<ReaderTarget> reader_targets() {
   using namespace datasets;
