@@ -25,22 +25,11 @@
 
 #include "framework/core/atomic_file.hpp"
 #include "framework/core/error.hpp"
+#include "tests/fuzz/fuzz_harness.hpp"
 
 namespace skinlab::fuzz {
 
-namespace fs = std::filesystem;
-
-/// SKINLAB_FUZZ_SECONDS (default 60): the time budget of one target.
-inline double budget_seconds() {
-  const char* env = std::getenv("SKINLAB_FUZZ_SECONDS");
-  return env != nullptr ? std::atof(env) : 60.0;
-}
-
-/// SKINLAB_FUZZ_SEED (default 1).
-inline std::uint64_t seed() {
-  const char* env = std::getenv("SKINLAB_FUZZ_SEED");
-  return env != nullptr ? std::strtoull(env, nullptr, 10) : 1;
-}
+// budget_seconds() and seed() (SKINLAB_FUZZ_SECONDS, SKINLAB_FUZZ_SEED) are the harness's.
 
 /// The per-input time limit in seconds (SKINLAB_FUZZ_INPUT_SECONDS, default 5).
 inline unsigned input_seconds() {
@@ -175,8 +164,8 @@ inline void mutate_bytes(std::string& s, std::mt19937_64& rng) {
   }
 }
 
-/// Counts of one target's run.
-struct Tally {
+/// Counts of one target's run, by outcome.
+struct ForkTally {
   long tried = 0;
   long counts[5] = {0, 0, 0, 0, 0};  ///< by Outcome
   long failures() const {
@@ -196,10 +185,10 @@ inline fs::path findings_dir() {
 /// `file` and `parse` runs on it in a forked child. Every time-out, crash or exception other
 /// than skinlab::Error is a test failure, and its input is saved under
 /// findings_dir()/<target>/ (to be moved to tests/data/fuzz_regressions/files/<target>/ once fixed).
-inline Tally fuzz_file(const std::string& target, const std::vector<std::string>& seeds,
+inline ForkTally fuzz_file(const std::string& target, const std::vector<std::string>& seeds,
                        const fs::path& file, const std::function<void()>& parse) {
   std::mt19937_64 rng(seed());
-  Tally t;
+  ForkTally t;
   const auto start = std::chrono::steady_clock::now();
   const auto end = start + std::chrono::duration<double>(budget_seconds());
   std::vector<std::string> reported;

@@ -33,7 +33,7 @@ TEST_P(FileFuzz, EveryMutantIsAcceptedOrRejectedWithinTheTimeLimit) {
       ASSERT_NO_THROW(target.parse(file)) << target.name << " seed " << i;
     }
     const std::filesystem::path file = dir / ("fuzzed" + target.extension);
-    const fuzz::Tally t = fuzz::fuzz_file(target.name, seeds, file, [&] { target.parse(file); });
+    const fuzz::ForkTally t = fuzz::fuzz_file(target.name, seeds, file, [&] { target.parse(file); });
     EXPECT_GT(t.tried, 100);
     EXPECT_GT(t.counts[static_cast<int>(fuzz::Outcome::kRejected)], 0);
     return;
