@@ -126,11 +126,12 @@ double overlap(const std::vector<std::uint64_t>& a, const std::vector<std::uint6
         for (int dy = -1; dy <= 1 && !found; ++dy) {
           for (int dx = -1; dx <= 1 && !found; ++dx) {
             // Packed x|y|z with 21 bits each and coordinates offset by 2^20: adding a signed
-            // offset per field cannot carry across fields for cells inside the range.
-            const std::uint64_t k =
-                key + static_cast<std::uint64_t>(static_cast<std::int64_t>(dx) << 42) +
-                static_cast<std::uint64_t>(static_cast<std::int64_t>(dy) << 21) +
-                static_cast<std::uint64_t>(static_cast<std::int64_t>(dz));
+            // offset per field cannot carry across fields for cells inside the range. Shifted
+            // as unsigned (modulo 2^64, the same bits): shifting a negative signed value left is
+            // undefined before C++20 (UBSan found -1 << 42 here).
+            const std::uint64_t k = key + (static_cast<std::uint64_t>(dx) << 42) +
+                                    (static_cast<std::uint64_t>(dy) << 21) +
+                                    static_cast<std::uint64_t>(dz);
             found = std::binary_search(to.begin(), to.end(), k);
           }
         }
