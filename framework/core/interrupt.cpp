@@ -13,7 +13,7 @@
 
 namespace skinlab {
 
-namespace {
+namespace interrupt_detail {
 
 /// One registered path. `state`: 0 free, 1 being filled (or claimed while dying), 2 ready.
 struct Slot {
@@ -73,16 +73,18 @@ void on_signal(int sig) {
   ::raise(sig);  // delivered with the default action (end of the process) when this returns
 }
 
-}  // namespace
+}  // namespace interrupt_detail
+
+namespace intr = interrupt_detail;
 
 void install_interrupt_cleanup(const char* program) {
-  std::strncpy(program_name, program, sizeof(program_name) - 1);
-  stderr_is_terminal = ::isatty(STDERR_FILENO) == 1;
+  std::strncpy(intr::program_name, program, sizeof(intr::program_name) - 1);
+  intr::stderr_is_terminal = ::isatty(STDERR_FILENO) == 1;
   struct sigaction action {};
-  action.sa_handler = on_signal;
+  action.sa_handler = intr::on_signal;
   sigemptyset(&action.sa_mask);
-  for (int sig : kSignals) sigaddset(&action.sa_mask, sig);
-  for (int sig : kSignals) {
+  for (int sig : intr::kSignals) sigaddset(&action.sa_mask, sig);
+  for (int sig : intr::kSignals) {
     struct sigaction previous {};
     if (::sigaction(sig, nullptr, &previous) == 0 && previous.sa_handler == SIG_IGN) continue;
     ::sigaction(sig, &action, nullptr);
@@ -92,27 +94,27 @@ void install_interrupt_cleanup(const char* program) {
 void remove_on_interrupt(const std::filesystem::path& path) {
   const std::string& text = path.native();
   if (text.size() >= PATH_MAX) return;
-  for (std::size_t i = 0; i < slots.size(); ++i) {
+  for (std::size_t i = 0; i < intr::slots.size(); ++i) {
     int expected = 0;
-    if (!slots[i].state.compare_exchange_strong(expected, 1)) continue;
+    if (!intr::slots[i].state.compare_exchange_strong(expected, 1)) continue;
     // The handler is removing files: this one is not created yet, and the process is ending.
-    while (dying.load()) ::pause();
-    std::memcpy(slots[i].path, text.c_str(), text.size() + 1);
+    while (intr::dying.load()) ::pause();
+    std::memcpy(intr::slots[i].path, text.c_str(), text.size() + 1);
     {
-      const std::lock_guard<std::mutex> lock(owners_mutex);
-      owners.emplace(text, i);
+      const std::lock_guard<std::mutex> lock(intr::owners_mutex);
+      intr::owners.emplace(text, i);
     }
-    slots[i].state.store(2);
+    intr::slots[i].state.store(2);
     return;
   }
 }
 
 void keep_on_interrupt(const std::filesystem::path& path) {
-  const std::lock_guard<std::mutex> lock(owners_mutex);
-  const auto it = owners.find(path.native());
-  if (it == owners.end()) return;
-  slots[it->second].state.store(0);
-  owners.erase(it);
+  const std::lock_guard<std::mutex> lock(intr::owners_mutex);
+  const auto it = intr::owners.find(path.native());
+  if (it == intr::owners.end()) return;
+  intr::slots[it->second].state.store(0);
+  intr::owners.erase(it);
 }
 
 }  // namespace skinlab

@@ -23,7 +23,7 @@ namespace skinlab {
 
 namespace fs = std::filesystem;
 
-namespace {
+namespace output_lock_detail {
 
 std::string now_utc() {
   const std::time_t now = std::time(nullptr);
@@ -98,7 +98,9 @@ bool same_file(int fd, const fs::path& path) {
   throw IoError(path.string() + ": " + what + ": " + std::strerror(errno));
 }
 
-}  // namespace
+}  // namespace output_lock_detail
+
+namespace lockd = output_lock_detail;
 
 fs::path lock_file_of(const fs::path& output) {
   fs::path out = output;
@@ -119,50 +121,50 @@ OutputLock::OutputLock(fs::path lock_file, std::string output,
   // file and then gets its lock finds the name no longer refers to it and tries again.
   for (int attempt = 0; attempt < 100 && fd_ < 0; ++attempt) {
     const int fd = ::open(file_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (fd < 0) fail(file_, "cannot create the lock file");
+    if (fd < 0) lockd::fail(file_, "cannot create the lock file");
     if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
       if (errno != EWOULDBLOCK) {
         ::close(fd);
-        fail(file_, "cannot lock");
+        lockd::fail(file_, "cannot lock");
       }
       // The owner writes its record right after locking: give it a moment.
-      std::string owner = read_all(fd);
-      for (int wait = 0; wait < 20 && fields(owner)["pid"].empty(); ++wait) {
+      std::string owner = lockd::read_all(fd);
+      for (int wait = 0; wait < 20 && lockd::fields(owner)["pid"].empty(); ++wait) {
         std::this_thread::sleep_for(std::chrono::milliseconds(10));
-        owner = read_all(fd);
+        owner = lockd::read_all(fd);
       }
       ::close(fd);
       throw Error(fmt::format("{} is being written by {}; wait for it to finish or stop it (lock {})",
-                              output, owner_text(owner), file_.string()));
+                              output, lockd::owner_text(owner), file_.string()));
     }
-    if (!same_file(fd, file_)) {
+    if (!lockd::same_file(fd, file_)) {
       ::close(fd);
       continue;
     }
     fd_ = fd;
   }
   if (fd_ < 0) throw IoError(file_.string() + ": cannot take the lock (its file keeps changing)");
-  const std::string previous = read_all(fd_);
-  if (!fields(previous)["pid"].empty()) {
+  const std::string previous = lockd::read_all(fd_);
+  if (!lockd::fields(previous)["pid"].empty()) {
     spdlog::warn("{}: taking over the lock of {}, which no longer holds it (ended without "
-                 "releasing it)", file_.string(), owner_text(previous));
+                 "releasing it)", file_.string(), lockd::owner_text(previous));
   }
-  const std::string record = fmt::format("pid: {}\nhost: {}\nstarted: {}\ncommand: {}\noutput: {}\n",
-                                         ::getpid(), host_name(), now_utc(), command_text(command),
-                                         output);
+  const std::string record =
+      fmt::format("pid: {}\nhost: {}\nstarted: {}\ncommand: {}\noutput: {}\n", ::getpid(),
+                  lockd::host_name(), lockd::now_utc(), lockd::command_text(command), output);
   if (::ftruncate(fd_, 0) != 0 ||
       ::pwrite(fd_, record.data(), record.size(), 0) != static_cast<ssize_t>(record.size())) {
     const int error = errno;
     ::close(fd_);
     errno = error;
-    fail(file_, "cannot write the lock file");
+    lockd::fail(file_, "cannot write the lock file");
   }
   remove_on_interrupt(file_);
 }
 
 OutputLock::~OutputLock() {
   keep_on_interrupt(file_);
-  if (same_file(fd_, file_)) ::unlink(file_.c_str());  // still holding the lock
+  if (lockd::same_file(fd_, file_)) ::unlink(file_.c_str());  // still holding the lock
   ::close(fd_);
 }
 
