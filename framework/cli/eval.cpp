@@ -10,14 +10,20 @@
 /// `--nproc N` shards the characters of a skinning run over N worker processes on this machine
 /// (core/launch.hpp); rank 0 gathers the values and predictions and writes the files. A process
 /// started with WORLD_SIZE > 1 is one rank of such an evaluation (train/distributed.hpp).
+///
+/// The process that writes the files (alone, the `--nproc` launcher, or rank 0) holds
+/// `<run>/eval_<part>.lock` (core/output_lock.hpp): a second evaluation of the same part of the
+/// same run fails at once, naming the first. Evaluating a run while it trains is allowed.
 
 #include <fmt/format.h>
 
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 
 #include "framework/tensors/threads.hpp"
 #include "framework/cli/commands.hpp"
@@ -28,6 +34,7 @@
 #include "framework/eval/evaluator.hpp"
 #include "framework/core/error.hpp"
 #include "framework/core/launch.hpp"
+#include "framework/core/output_lock.hpp"
 #include "framework/train/distributed.hpp"
 #include "framework/train/run_options.hpp"
 #include "framework/train/trainer.hpp"
@@ -69,6 +76,11 @@ int run_eval(EvalArgs args) {
                 " is not a config file");
   }
   const RunDir run = from_config ? create_binder_run(args) : RunDir::open(args.run);
+  std::optional<OutputLock> lock;  // the launcher's workers write under their launcher's lock
+  if (std::getenv("SKINLAB_LAUNCHED") == nullptr && train::WorldOptions::from_environment().rank == 0) {
+    lock.emplace(eval_lock_of(run.path(), args.options.part),
+                 run.file("eval_" + args.options.part + ".json").string(), command_line());
+  }
   if (args.nproc > 1) {
     const config::Config config = config::Config::load(run.file("config.yaml"), args.options.overrides);
     task::require_data_parallel(task::of(config), run.path().string(), "sharded evaluation (--nproc)",

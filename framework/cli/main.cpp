@@ -15,6 +15,7 @@
 #include "framework/core/config.hpp"
 #include "framework/core/environment.hpp"
 #include "framework/core/error.hpp"
+#include "framework/core/interrupt.hpp"
 #include "framework/core/logging.hpp"
 #include "framework/core/registry.hpp"
 #include "framework/cli/commands.hpp"
@@ -90,6 +91,7 @@ Command add_config(CLI::App& app) {
 }  // namespace skinlab::cli
 
 int main(int argc, char** argv) {
+  skinlab::install_interrupt_cleanup("skinlab");
   skinlab::keep_freed_memory();
   skinlab::cli::command_line_storage().assign(argv, argv + argc);
   CLI::App app{"skinlab: learned character skinning (HeterSkinNet and baselines)"};

@@ -8,15 +8,22 @@
 /// each writing its characters' partial files, then merges them into the one file. A process
 /// started with WORLD_SIZE > 1 (several nodes sharing the output's file system, with
 /// MASTER_ADDR/MASTER_PORT) prepares shard RANK and waits for the others; rank 0 merges.
+///
+/// One writer per output: the process that writes the output file (alone, the `--nproc`
+/// launcher, or rank 0) holds `<output>.lock` from the start (core/output_lock.hpp); a second
+/// `skinlab prepare` of the same output fails at once, naming the first.
 
 #include <fmt/format.h>
 
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
+#include <optional>
 
 #include "framework/cli/commands.hpp"
 #include "framework/core/config.hpp"
 #include "framework/core/launch.hpp"
+#include "framework/core/output_lock.hpp"
 #include "framework/data/prepare.hpp"
 #include "framework/train/distributed.hpp"
 
@@ -35,6 +42,12 @@ int run_prepare(PrepareArgs args) {
   const config::Config config = config::Config::load(args.file, args.overrides);
   const data::PrepareConfig prepare = data::PrepareConfig::from(config);
   const bool launched = std::getenv("SKINLAB_LAUNCHED") != nullptr;
+  const train::WorldOptions world_options = train::WorldOptions::from_environment();
+  std::optional<OutputLock> lock;  // the launcher's workers write under their launcher's lock
+  if (!launched && (args.nproc > 1 || world_options.rank == 0)) {
+    if (prepare.output.has_parent_path()) std::filesystem::create_directories(prepare.output.parent_path());
+    lock.emplace(lock_file_of(prepare.output), prepare.output.string(), command_line());
+  }
   if (args.nproc > 1) {
     LaunchOptions launch;
     launch.nproc = args.nproc;
@@ -44,7 +57,7 @@ int run_prepare(PrepareArgs args) {
     launch.args.insert(launch.args.end(), {"--threads", std::to_string(threads), "--keep-partial"});
     launch.environment = {"SKINLAB_LAUNCHED=1"};
     launch_local(launch);  // each worker prepares its shard
-  } else if (const train::WorldOptions w = train::WorldOptions::from_environment(); w.distributed()) {
+  } else if (const train::WorldOptions& w = world_options; w.distributed()) {
     args.options.shard_index = w.rank;
     args.options.shard_count = w.size;
     args.options.progress = args.options.progress && w.rank == 0;

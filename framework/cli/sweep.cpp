@@ -21,7 +21,9 @@
 /// A sweep can be interrupted and run again: an entry whose run directory exists continues
 /// (training resumes from last.pt; a finished run is only re-evaluated if its evaluation is
 /// missing), provided the resolved config is unchanged; a changed config is an error naming
-/// the run, so results are never mixed.
+/// the run, so results are never mixed. Like `skinlab train` and `skinlab eval`, a sweep holds
+/// an entry's `train.lock` while training it and `eval_<part>.lock` while evaluating it
+/// (core/output_lock.hpp), so a sweep and another process never write the same run at once.
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -38,6 +40,7 @@
 #include "framework/core/config.hpp"
 #include "framework/core/environment.hpp"
 #include "framework/core/error.hpp"
+#include "framework/core/output_lock.hpp"
 #include "framework/core/run_dir.hpp"
 #include "framework/eval/evaluator.hpp"
 #include "framework/report/table.hpp"
@@ -109,6 +112,8 @@ fs::path run_entry(const Sweep& sweep, const Entry& entry, int threads) {
       e.part = sweep.part;
       e.predictions = sweep.predictions;
       if (threads >= 0) set_torch_threads(threads);
+      const OutputLock lock(eval_lock_of(run.path(), e.part),
+                            run.file("eval_" + e.part + ".json").string(), command_line());
       task::evaluate_run(run, e);
     }
     return run.path();
@@ -158,6 +163,7 @@ fs::path run_entry(const Sweep& sweep, const Entry& entry, int threads) {
   if (!binder) {
     const std::unique_ptr<task::TaskTrainer> trainer = task::make_trainer(config);
     run = existed ? RunDir::open(dir) : train::create_run(config, o, run_id, command_line());
+    const OutputLock lock(train_lock_of(run->path()), run->path().string(), command_line());
     const train::TrainResult r = trainer->fit(*run, {});
     spdlog::info("{}: {} epochs, best epoch {} (validation loss {:.6g})", o.experiment, r.epochs,
                  r.best_epoch, r.best_loss);
@@ -167,6 +173,8 @@ fs::path run_entry(const Sweep& sweep, const Entry& entry, int threads) {
   eval::EvalOptions e;
   e.part = sweep.part;
   e.predictions = sweep.predictions;
+  const OutputLock lock(eval_lock_of(run->path(), e.part),
+                        run->file("eval_" + e.part + ".json").string(), command_line());
   const eval::EvalReport report = task::evaluate_run(*run, e);
   std::cout << fmt::format("   {} characters, {:.1f} s\n", report.characters.size(), report.seconds);
   return run->path();

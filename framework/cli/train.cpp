@@ -11,6 +11,10 @@
 /// is one rank of the run. Started by hand, every rank needs the same `--run-id` (or
 /// `--resume`): rank 0 creates the directory, the others wait for it. Only rank 0 logs to the
 /// console at info level and writes the run's files.
+///
+/// One trainer per run: the process that writes the run (alone, the `--nproc` launcher, or rank
+/// 0) holds `<run>/train.lock` (core/output_lock.hpp) from when the run is created or opened to
+/// the end, so a second `skinlab train --resume` of it fails at once, naming the first.
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -28,6 +32,7 @@
 #include "framework/core/error.hpp"
 #include "framework/core/launch.hpp"
 #include "framework/core/logging.hpp"
+#include "framework/core/output_lock.hpp"
 #include "framework/core/run_dir.hpp"
 #include "framework/train/distributed.hpp"
 #include "framework/train/trainer.hpp"
@@ -48,7 +53,7 @@ struct TrainArgs {
 /// `--nproc N`: validates the config, creates (or opens) the run, writes its env record with
 /// the world size and runs N workers on it.
 int launch_train(const TrainArgs& args, const std::optional<RunDir>& resumed,
-                 const config::Config& config) {
+                 const config::Config& config, std::optional<OutputLock>& lock) {
   const train::RunOptions options = train::RunOptions::from(config);
   options.require_training_sections(config);
   task::require_data_parallel(task::get(options.task), config.source(),
@@ -60,6 +65,7 @@ int launch_train(const TrainArgs& args, const std::optional<RunDir>& resumed,
   std::optional<RunDir> run = resumed;
   if (!run) {
     run = RunDir::create(options.results_dir, options.experiment, args.run_id);
+    lock.emplace(train_lock_of(run->path()), run->path().string(), command_line());
     run->write_config(config.to_yaml());
     run->write_env(env);
   } else {
@@ -93,11 +99,17 @@ int run_train(TrainArgs args) {
   if (args.file.empty() && args.resume.empty()) {
     throw Error("train: give an experiment config, or --resume <run_dir>");
   }
+  const bool launched = std::getenv("SKINLAB_LAUNCHED") != nullptr;
+  const train::WorldOptions world_options = train::WorldOptions::from_environment();
+  // The launcher's workers train under its lock; of a world started by hand, rank 0 holds it.
+  const bool locks = !launched && world_options.rank == 0;
+  std::optional<OutputLock> lock;
   std::optional<RunDir> run;
   std::optional<config::Config> config;
   if (!args.resume.empty()) {
     if (!args.run_id.empty()) throw Error("train: --run-id and --resume exclude each other");
     run = RunDir::open(args.resume);
+    if (locks) lock.emplace(train_lock_of(run->path()), run->path().string(), command_line());
     config = config::Config::load(run->file("config.yaml"));
     if (!args.file.empty()) {
       // The run's own config governs; a config given as well must resolve to the same thing.
@@ -114,25 +126,26 @@ int run_train(TrainArgs args) {
   } else {
     config = config::Config::load(args.file, args.overrides);
   }
-  if (args.nproc > 1) return launch_train(args, run, *config);
+  if (args.nproc > 1) return launch_train(args, run, *config, lock);
   const train::RunOptions options = train::RunOptions::from(*config);
   const int threads = set_torch_threads(args.threads >= 0 ? args.threads : options.threads);
 
   // One rank of a data-parallel run when WORLD_SIZE > 1 (see the file comment).
-  const train::WorldOptions world_options = train::WorldOptions::from_environment();
   if (world_options.distributed() && !run && args.run_id.empty()) {
     throw Error("train: a rank of a data-parallel run (WORLD_SIZE > 1) needs --run-id or "
                 "--resume, the same for every rank");
   }
   train::World world(world_options);
-  const bool launched = std::getenv("SKINLAB_LAUNCHED") != nullptr;
   if (world.distributed() && !world.writer()) spdlog::set_level(spdlog::level::warn);
 
   // Everything that can fail on the config, the dataset or the model fails here, before a run
   // directory exists. The config's task decides the trainer.
   const std::unique_ptr<task::TaskTrainer> trainer = task::make_trainer(*config, &world);
   if (!run) {
-    if (world.writer()) run = train::create_run(*config, options, args.run_id, command_line());
+    if (world.writer()) {
+      run = train::create_run(*config, options, args.run_id, command_line());
+      if (locks) lock.emplace(train_lock_of(run->path()), run->path().string(), command_line());
+    }
     world.barrier();  // the other ranks open what rank 0 created
     if (!run) run = RunDir::open(std::filesystem::path(options.results_dir) / options.experiment / args.run_id);
   } else if (world.writer() && !launched) {

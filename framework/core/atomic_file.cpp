@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "framework/core/error.hpp"
+#include "framework/core/interrupt.hpp"
 
 namespace skinlab {
 
@@ -39,6 +40,7 @@ AtomicPath::AtomicPath(fs::path target) : target_(std::move(target)) {
   const fs::path dir = target_.has_parent_path() ? target_.parent_path() : fs::path(".");
   temp_ = dir / ("." + target_.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
                  std::to_string(temp_counter++));
+  remove_on_interrupt(temp_);
 }
 
 AtomicPath::~AtomicPath() {
@@ -46,6 +48,7 @@ AtomicPath::~AtomicPath() {
     std::error_code ignored;
     fs::remove(temp_, ignored);
   }
+  if (!committed_) keep_on_interrupt(temp_);
 }
 
 void AtomicPath::commit() {
@@ -57,6 +60,7 @@ void AtomicPath::commit() {
   fsync_path(temp_, O_RDONLY);
   if (::rename(temp_.c_str(), target_.c_str()) != 0) fail(target_, "cannot rename into place");
   committed_ = true;
+  keep_on_interrupt(temp_);
   const fs::path dir = target_.has_parent_path() ? target_.parent_path() : fs::path(".");
   fsync_path(dir, O_RDONLY | O_DIRECTORY);
 }

@@ -5,6 +5,7 @@
 #include <netinet/in.h>
 #include <signal.h>
 #include <spdlog/spdlog.h>
+#include <sys/prctl.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -62,6 +63,7 @@ void launch_local(const LaunchOptions& options) {
   std::vector<std::string> argv_text{"/proc/self/exe"};
   argv_text.insert(argv_text.end(), options.args.begin(), options.args.end());
   std::vector<pid_t> pids;
+  const pid_t parent = ::getpid();
   for (int rank = 0; rank < options.nproc; ++rank) {
     std::vector<std::string> env = options.environment;
     env.push_back(fmt::format("RANK={}", rank));
@@ -75,6 +77,11 @@ void launch_local(const LaunchOptions& options) {
       throw IoError(std::string("launch: fork(): ") + std::strerror(errno));
     }
     if (pid == 0) {
+      // A launcher that is interrupted or killed takes its workers with it (SIGTERM: they
+      // remove their temporary files, core/interrupt.hpp) instead of leaving them writing
+      // outputs whose lock the launcher no longer holds.
+      ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+      if (::getppid() != parent) std::_Exit(1);
       for (const std::string& e : env) ::putenv(const_cast<char*>(e.c_str()));
       std::vector<char*> argv;
       for (const std::string& a : argv_text) argv.push_back(const_cast<char*>(a.c_str()));

@@ -8,7 +8,8 @@
 /// Failure: when a worker exits with a non-zero status or is killed, the others are sent
 /// SIGTERM, given `grace` to exit and then SIGKILL, and the launch fails with an Error naming the
 /// first worker that failed and how. The workers' own collectives also fail at once when a peer
-/// closes its connections, so a run never hangs on a dead worker.
+/// closes its connections, so a run never hangs on a dead worker. A launcher that ends (Ctrl-C,
+/// kill) sends its workers SIGTERM (PR_SET_PDEATHSIG).
 
 #include <chrono>
 #include <string>

@@ -27,12 +27,14 @@
 
 #include "framework/core/environment.hpp"
 #include "framework/core/error.hpp"
+#include "framework/core/interrupt.hpp"
 #include "framework/core/logging.hpp"
 #include "framework/core/registry.hpp"
 #include "framework/infer/eigen_predictor.hpp"
 #include "framework/infer/predict_command.hpp"
 
 int main(int argc, char** argv) {
+  skinlab::install_interrupt_cleanup("skinlab-predict");
   skinlab::keep_freed_memory();
   CLI::App app{"skinlab-predict: skin weights for characters with a bundled HeterSkinNet, "
                "without libtorch (glTF, rig text, HDF5): one input with --out FILE, or many "
