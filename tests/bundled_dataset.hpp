@@ -2,12 +2,19 @@
 // Prepares a dataset config on the bundled real 0 A.D. subset (datasets/zeroad/bundled) for
 // tests: its output redirected, two threads, no progress output, extra overrides appended.
 
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <set>
 #include <string>
 #include <vector>
 
+#include "framework/core/atomic_file.hpp"
 #include "framework/core/config.hpp"
+#include "framework/core/registry.hpp"
 #include "framework/data/dataset_file.hpp"
 #include "framework/data/prepare.hpp"
+#include "framework/data/source.hpp"
 
 namespace skinlab::testing {
 
@@ -30,6 +37,23 @@ inline data::Dataset prepare_bundled(const std::string& config, const std::strin
   quiet.progress = false;
   data::prepare_dataset(bundled_config(config, output, extra), quiet);
   return data::read_dataset(output);
+}
+
+/// The characters of the bundled 0 A.D. subset, as its builder reads them from the game files,
+/// that the evaluation of the model in `model_dir` (its eval_test.json) scored.
+inline std::vector<datasets::SourceCharacter> bundled_test_characters(
+    const std::filesystem::path& model_dir) {
+  const nlohmann::json eval = nlohmann::json::parse(read_file(model_dir / "eval_test.json"));
+  std::set<std::string> test;
+  for (const auto& c : eval.at("per_character")) test.insert(c.at("character").get<std::string>());
+  const data::PrepareConfig config =
+      bundled_config("configs/datasets/zeroad_bundled.yaml", "unused.h5");
+  std::vector<datasets::Excluded> excluded;
+  std::vector<datasets::SourceCharacter> characters;
+  for (const auto& node : config.sources)
+    for (auto& source : dataset_registry().create(node)->read(excluded))
+      if (test.count(source.character.name)) characters.push_back(std::move(source));
+  return characters;
 }
 
 }  // namespace skinlab::testing

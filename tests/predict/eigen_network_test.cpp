@@ -49,37 +49,26 @@ TEST(EigenNetwork, BundledModelEqualsLibtorchOnItsTestCharacters) {
   const infer::EigenPredictor eigen_model = infer::EigenPredictor::load(dir);
   EXPECT_EQ(eigen_model.distance(), torch_model.distance());
 
-  // The test characters of the bundled model's evaluation that the bundled 0 A.D. subset holds.
-  const nlohmann::json eval = nlohmann::json::parse(read_file(dir / "eval_test.json"));
-  std::set<std::string> test;
-  for (const auto& c : eval.at("per_character")) test.insert(c.at("character").get<std::string>());
-  TempDir tmp;
-  const data::PrepareConfig config =
-      testing::bundled_config("configs/datasets/zeroad_bundled.yaml", (tmp / "unused.h5").string());
-  std::vector<datasets::Excluded> excluded;
   int compared = 0;
-  for (const auto& node : config.sources) {
-    for (const auto& source : dataset_registry().create(node)->read(excluded)) {
-      if (!test.count(source.character.name)) continue;
-      SCOPED_TRACE(source.character.name);
-      predict::PredictOptions options;
-      options.up = source.up;
-      const predict::Prediction t = torch_model.predict(source.character, options);
-      const predict::Prediction e = eigen_model.predict(source.character, options);
-      const double candidates = max_difference(t.candidates, e.candidates);
-      EXPECT_LE(candidates, 1e-5);
-      EXPECT_LE(max_difference(t.prepared_weights, e.prepared_weights), 1e-5);
-      EXPECT_LE(max_difference(t.source_weights, e.source_weights), 1e-5);
-      // The paper's precision and recall (Sec. 4.3) of both against the artist's weights.
-      const auto mt = torch_model.compare(t), me = torch_model.compare(e);
-      EXPECT_EQ(mt.at("precision"), me.at("precision"));
-      EXPECT_EQ(mt.at("recall"), me.at("recall"));
-      EXPECT_GT(mt.at("precision"), 0.3) << "a trained model, not a random one";
-      std::cout << source.character.name << ": " << t.prepared.num_vertices()
-                << " prepared vertices, max |Eigen - libtorch| " << candidates
-                << ", precision " << mt.at("precision") << ", recall " << mt.at("recall") << "\n";
-      ++compared;
-    }
+  for (const auto& source : testing::bundled_test_characters(dir)) {
+    SCOPED_TRACE(source.character.name);
+    predict::PredictOptions options;
+    options.up = source.up;
+    const predict::Prediction t = torch_model.predict(source.character, options);
+    const predict::Prediction e = eigen_model.predict(source.character, options);
+    const double candidates = max_difference(t.candidates, e.candidates);
+    EXPECT_LE(candidates, 1e-5);
+    EXPECT_LE(max_difference(t.prepared_weights, e.prepared_weights), 1e-5);
+    EXPECT_LE(max_difference(t.source_weights, e.source_weights), 1e-5);
+    // The paper's precision and recall (Sec. 4.3) of both against the artist's weights.
+    const auto mt = torch_model.compare(t), me = torch_model.compare(e);
+    EXPECT_EQ(mt.at("precision"), me.at("precision"));
+    EXPECT_EQ(mt.at("recall"), me.at("recall"));
+    EXPECT_GT(mt.at("precision"), 0.3) << "a trained model, not a random one";
+    std::cout << source.character.name << ": " << t.prepared.num_vertices()
+              << " prepared vertices, max |Eigen - libtorch| " << candidates
+              << ", precision " << mt.at("precision") << ", recall " << mt.at("recall") << "\n";
+    ++compared;
   }
   EXPECT_GE(compared, 2) << "f_dress and m_armor_pants are in the bundled subset";
 }
