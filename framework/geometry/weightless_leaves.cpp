@@ -6,15 +6,9 @@
 
 namespace skinlab::geometry {
 
-std::vector<int> drop_weightless_leaves(Character& character) {
+std::vector<int> drop_leaves(Character& character, const std::function<bool(int)>& removable) {
   Skeleton& s = character.skeleton;
   const int n = s.num_joints();
-  std::vector<double> mass(static_cast<std::size_t>(n), 0.0);
-  for (int v = 0; v < character.weights.outerSize(); ++v) {
-    for (SparseWeights::InnerIterator it(character.weights, v); it; ++it) {
-      mass[static_cast<std::size_t>(it.col())] += std::abs(it.value());
-    }
-  }
   std::vector<int> children(static_cast<std::size_t>(n), 0);
   for (int j = 0; j < n; ++j) {
     if (s.parents[j] >= 0) ++children[static_cast<std::size_t>(s.parents[j])];
@@ -25,7 +19,7 @@ std::vector<int> drop_weightless_leaves(Character& character) {
     changed = false;
     for (int j = 0; j < n; ++j) {
       const auto u = static_cast<std::size_t>(j);
-      if (removed[u] || s.parents[j] < 0 || children[u] > 0 || mass[u] > 0) continue;
+      if (removed[u] || s.parents[j] < 0 || children[u] > 0 || !removable(j)) continue;
       removed[u] = true;
       --children[static_cast<std::size_t>(s.parents[j])];
       ++count;
@@ -56,10 +50,22 @@ std::vector<int> drop_weightless_leaves(Character& character) {
     const int p = s.parents[j];
     kept.parents.push_back(p < 0 ? -1 : new_index[static_cast<std::size_t>(p)]);
   }
-  // the removed joints carry no weight, so this only re-indexes the kept columns
-  character.weights = onto_kept_joints(character.weights, s.parents, kept_joints);
+  if (character.has_weights()) {
+    character.weights = onto_kept_joints(character.weights, s.parents, kept_joints);
+  }
   s = std::move(kept);
   return kept_joints;
+}
+
+std::vector<int> drop_weightless_leaves(Character& character) {
+  std::vector<double> mass(static_cast<std::size_t>(character.skeleton.num_joints()), 0.0);
+  for (int v = 0; v < character.weights.outerSize(); ++v) {
+    for (SparseWeights::InnerIterator it(character.weights, v); it; ++it) {
+      mass[static_cast<std::size_t>(it.col())] += std::abs(it.value());
+    }
+  }
+  // the removed joints carry no weight, so drop_leaves only re-indexes the kept columns
+  return drop_leaves(character, [&](int j) { return mass[static_cast<std::size_t>(j)] == 0; });
 }
 
 SparseWeights onto_kept_joints(const SparseWeights& weights, const std::vector<int>& parents,

@@ -8,18 +8,24 @@
 /// A model trained on one convention sees only one kind of leaf; training on both (preprocess's
 /// `drop_weightless_leaves`) shows it leaf joints that carry weight and leaf joints that do not.
 
+#include <functional>
 #include <vector>
 
 #include "framework/geometry/skin_weights.hpp"
 
 namespace skinlab::geometry {
 
-/// Removes, repeatedly, every leaf joint whose weight column is zero, until every leaf carries
-/// weight (or only the root is left); the root is never removed. Joint order is kept, parents
-/// and the weight columns are re-indexed, and leaf tips (if set) are dropped with their joints.
-/// Requires a validated character with weights. Returns the original indices of the joints
-/// kept, in order (every joint when nothing was removed), to re-index per-joint data such as
-/// animation transforms.
+/// Removes, repeatedly, every leaf joint j (never the root) for which `removable(j)` holds, j
+/// an index of the skeleton as given: a chain of removable end joints goes whole, a removable
+/// joint above a kept one stays. Joint order is kept, parents are re-indexed, leaf tips (if
+/// set) are dropped with their joints, and the weights (if any) move onto the kept joints by
+/// onto_kept_joints (a removed joint's weight to its nearest kept ancestor). Returns the
+/// original indices of the joints kept, in order (every joint when nothing was removed).
+std::vector<int> drop_leaves(Character& character, const std::function<bool(int)>& removable);
+
+/// drop_leaves of every joint whose weight column is zero, until every leaf carries weight (or
+/// only the root is left). Requires a validated character with weights. Returns the original
+/// indices of the joints kept, to re-index per-joint data such as animation transforms.
 std::vector<int> drop_weightless_leaves(Character& character);
 
 /// Another set of weights of the same rig (#V×#J, the skeleton before the drop, whose `parents`

@@ -88,11 +88,11 @@ EigenPredictor EigenPredictor::load(const fs::path& dir) {
 
 Prediction EigenPredictor::predict(const geometry::Character& character,
                                    const PredictOptions& options, StageTimes* times) const {
-  data::PreparedCharacter prepared = prepare_to_predict(character, preparation_, options, times);
+  PreparedInput input = prepare_to_predict(character, preparation_, options, times);
   const auto start = std::chrono::steady_clock::now();
-  data::RowMatrixXf candidates = forward(network_, prepared, distance_);
+  data::RowMatrixXf candidates = forward(network_, input.prepared, distance_);
   if (times != nullptr) times->network += seconds_since(start);
-  return finish_prediction(std::move(prepared), distance_, std::move(candidates), options.prune,
+  return finish_prediction(std::move(input), distance_, std::move(candidates), options.prune,
                            times);
 }
 

@@ -76,8 +76,14 @@ geometry::Skeleton source_skeleton(const data::PreparedCharacter& character) {
     const Eigen::Vector4d p(character.joints(j, 0), character.joints(j, 1), character.joints(j, 2), 1);
     s.positions.row(j) = (back * p).head<3>().transpose();
   }
+  s.names = rig_joint_names(character.joint_names);
+  return s;
+}
+
+std::vector<std::string> rig_joint_names(const std::vector<std::string>& names) {
+  std::vector<std::string> out;
   std::set<std::string> used;
-  for (const auto& original : character.joint_names) {
+  for (const auto& original : names) {
     std::string name = original.empty() ? "joint" : original;
     for (char& ch : name) {
       if (ch == ' ' || ch == '\t' || ch == '\r' || ch == '\n' || ch == '#') ch = '_';
@@ -85,9 +91,9 @@ geometry::Skeleton source_skeleton(const data::PreparedCharacter& character) {
     std::string unique = name;
     for (int n = 2; used.count(unique); ++n) unique = name + "_" + std::to_string(n);
     used.insert(unique);
-    s.names.push_back(unique);
+    out.push_back(unique);
   }
-  return s;
+  return out;
 }
 
 }  // namespace skinlab::infer

@@ -10,6 +10,7 @@
 ///   bone-level rule of data/preprocess.hpp);
 /// - the skeleton in the source file's frame with names a rig text can hold.
 
+#include <string>
 #include <vector>
 
 #include "framework/data/dataset_file.hpp"
@@ -37,9 +38,12 @@ data::RowMatrixXf to_source_vertices(const data::RowMatrixXf& W, const std::vect
 geometry::SparseWeights joint_weights_of(const data::RowMatrixXf& W, const data::RowMatrixXi& bones,
                                          int num_joints);
 
+/// Joint names made writable in a rig file: whitespace and '#' become '_', an empty name becomes
+/// "joint", and a name that then collides gets a suffix `_2`, `_3`, ...
+std::vector<std::string> rig_joint_names(const std::vector<std::string>& names);
+
 /// The character's skeleton in its source file's frame (joint positions mapped through the
-/// inverse of PreparedCharacter::normalisation), with joint names made writable in a rig file:
-/// whitespace and '#' become '_', and a name that then collides gets a suffix `_2`, `_3`, ...
+/// inverse of PreparedCharacter::normalisation), with rig_joint_names.
 geometry::Skeleton source_skeleton(const data::PreparedCharacter& character);
 
 }  // namespace skinlab::infer

@@ -22,7 +22,12 @@ void write_h5(const fs::path& out, const geometry::Character& input, const Predi
   data::H5Writer w(out);
   w.write("weights", p.source_weights);
   w.write("joint_weights", data::RowMatrixXd(Eigen::MatrixXd(p.joint_weights)));
-  w.write("bones", p.prepared.bones);
+  // the bones' joints as the input's joint indices (the prepared skeleton may leave helper ends out)
+  data::RowMatrixXi bones = p.prepared.bones;
+  for (Eigen::Index i = 0; i < bones.size(); ++i) {
+    bones.data()[i] = p.input_joints[static_cast<std::size_t>(bones.data()[i])];
+  }
+  w.write("bones", bones);
   w.write_strings("joint_names", input.skeleton.names);
   w.write("vertices", data::RowMatrixXd(input.mesh.V));
   w.write_attribute("model", model);
@@ -58,7 +63,10 @@ void write_prediction(const fs::path& out, const geometry::Character& input, con
       break;
     }
     case OutputKind::rig: {
-      geometry::Skeleton named = source_skeleton(p.prepared);
+      // Every joint of the input, the left-out helper ends too (with no weight).
+      geometry::Skeleton named;
+      named.names = rig_joint_names(input.skeleton.names);
+      named.parents = input.skeleton.parents;
       named.positions = input.skeleton.positions;
       geometry::write_rig(out, named, p.joint_weights);
       break;

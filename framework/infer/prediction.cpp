@@ -1,6 +1,7 @@
 #include "framework/infer/prediction.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <chrono>
@@ -9,13 +10,35 @@
 #include "framework/core/error.hpp"
 #include "framework/core/timing.hpp"
 #include "framework/data/source.hpp"
+#include "framework/geometry/weightless_leaves.hpp"
 #include "framework/infer/map_back.hpp"
 
 namespace skinlab::infer {
 
 using Clock = std::chrono::steady_clock;
 
-void check_predictable(const geometry::Character& c, const PredictOptions& options) {
+namespace {
+
+/// #V×#J_kept joint weights as #V×#J_input: column k becomes column input_joints[k].
+geometry::SparseWeights onto_input_joints(const geometry::SparseWeights& W,
+                                          const std::vector<int>& input_joints,
+                                          int num_input_joints) {
+  if (static_cast<int>(input_joints.size()) == num_input_joints) return W;
+  std::vector<Eigen::Triplet<double>> entries;
+  for (Eigen::Index v = 0; v < W.outerSize(); ++v) {
+    for (geometry::SparseWeights::InnerIterator it(W, v); it; ++it) {
+      entries.emplace_back(static_cast<int>(v), input_joints[static_cast<std::size_t>(it.col())],
+                           it.value());
+    }
+  }
+  geometry::SparseWeights out(W.rows(), num_input_joints);
+  out.setFromTriplets(entries.begin(), entries.end());
+  return out;
+}
+
+}  // namespace
+
+std::vector<int> check_predictable(const geometry::Character& c, const PredictOptions& options) {
   const int nv = c.mesh.num_vertices();
   if (nv > options.max_vertices) {
     throw Error(fmt::format("{}: {} vertices, more than the limit of {} (max_vertices; the "
@@ -27,16 +50,45 @@ void check_predictable(const geometry::Character& c, const PredictOptions& optio
   const Eigen::RowVector3d lo = c.mesh.V.colwise().minCoeff(), hi = c.mesh.V.colwise().maxCoeff();
   const double diagonal = (hi - lo).norm();
   const auto& s = c.skeleton;
-  for (int j = 0; j < s.num_joints(); ++j) {
+  const int nj = s.num_joints();
+  auto outside_by = [&](int j) {
     const Eigen::RowVector3d p = s.positions.row(j);
-    const Eigen::RowVector3d outside = (lo - p).cwiseMax(p - hi).cwiseMax(0.0);
-    if (outside.norm() > options.max_joint_outside * diagonal) {
-      throw Error(fmt::format(
-          "{}: joint '{}' at ({:.4g}, {:.4g}, {:.4g}) lies {:.4g} outside the mesh's bounding "
-          "box [({:.4g}, {:.4g}, {:.4g}), ({:.4g}, {:.4g}, {:.4g})], more than {} of its "
-          "diagonal: the rig does not fit this mesh (units or frame?)",
-          c.name, s.names[j], p.x(), p.y(), p.z(), outside.norm(), lo.x(), lo.y(), lo.z(),
-          hi.x(), hi.y(), hi.z(), options.max_joint_outside));
+    return (lo - p).cwiseMax(p - hi).cwiseMax(0.0).norm();
+  };
+  std::vector<bool> outside(static_cast<std::size_t>(nj), false);
+  int first_outside = -1;
+  for (int j = 0; j < nj; ++j) {
+    outside[static_cast<std::size_t>(j)] = outside_by(j) > options.max_joint_outside * diagonal;
+    if (outside[static_cast<std::size_t>(j)] && first_outside < 0) first_outside = j;
+  }
+  auto does_not_fit = [&](int j, const std::string& why) {
+    const Eigen::RowVector3d p = s.positions.row(j);
+    return Error(fmt::format(
+        "{}: joint '{}' at ({:.4g}, {:.4g}, {:.4g}) lies {:.4g} outside the mesh's bounding "
+        "box [({:.4g}, {:.4g}, {:.4g}), ({:.4g}, {:.4g}, {:.4g})], more than {} of its "
+        "diagonal{}: the rig does not fit this mesh (units or frame?)",
+        c.name, s.names[j], p.x(), p.y(), p.z(), outside_by(j), lo.x(), lo.y(), lo.z(), hi.x(),
+        hi.y(), hi.z(), options.max_joint_outside, why));
+  };
+  std::vector<int> left_out;
+  if (first_outside >= 0) {
+    // The ends of the skeleton that lie wholly outside: what drop_leaves would remove.
+    geometry::Character ends;
+    ends.skeleton = s;
+    const std::vector<int> kept = geometry::drop_leaves(
+        ends, [&](int j) { return outside[static_cast<std::size_t>(j)]; });
+    std::vector<bool> is_kept(static_cast<std::size_t>(nj), false);
+    for (int j : kept) is_kept[static_cast<std::size_t>(j)] = true;
+    for (int j = 0; j < nj; ++j) {
+      if (!is_kept[static_cast<std::size_t>(j)]) {
+        left_out.push_back(j);
+      } else if (outside[static_cast<std::size_t>(j)]) {
+        throw does_not_fit(j, "");  // a joint with a part of the skeleton inside below it
+      }
+    }
+    if (2 * left_out.size() > static_cast<std::size_t>(nj)) {
+      throw does_not_fit(first_outside, fmt::format(" (with {} of the {} joints)",
+                                                    left_out.size(), nj));
     }
   }
   if (s.num_joints() >= 2) {
@@ -52,17 +104,38 @@ void check_predictable(const geometry::Character& c, const PredictOptions& optio
                               c.name, s.num_joints(), first.x(), first.y(), first.z()));
     }
   }
+  return left_out;
 }
 
-data::PreparedCharacter prepare_to_predict(const geometry::Character& character,
-                                           const Preparation& preparation,
-                                           const PredictOptions& options, StageTimes* times) {
+std::vector<int> without_helper_ends(geometry::Character& character,
+                                     const std::vector<int>& left_out) {
+  std::vector<bool> leave(static_cast<std::size_t>(character.skeleton.num_joints()), false);
+  for (int j : left_out) leave[static_cast<std::size_t>(j)] = true;
+  return geometry::drop_leaves(character,
+                               [&](int j) { return leave[static_cast<std::size_t>(j)]; });
+}
+
+PreparedInput prepare_to_predict(const geometry::Character& character,
+                                 const Preparation& preparation, const PredictOptions& options,
+                                 StageTimes* times) {
   if (!(options.prune >= 0 && options.prune <= 1)) {
     throw Error(fmt::format("prune must be in [0, 1], got {}", options.prune));
   }
-  check_predictable(character, options);
+  PreparedInput input;
+  input.left_out = check_predictable(character, options);
+  input.num_input_joints = character.skeleton.num_joints();
   datasets::SourceCharacter source;
   source.character = character;
+  input.input_joints = without_helper_ends(source.character, input.left_out);
+  if (!input.left_out.empty()) {
+    std::string names;
+    for (int j : input.left_out) {
+      names += (names.empty() ? "'" : ", '") + character.skeleton.names[j] + "'";
+    }
+    spdlog::warn("{}: {} outside the mesh at the end of the skeleton, left out of the "
+                 "prediction with weight 0 (an IK target or a controller skins nothing)",
+                 character.name, names);
+  }
   source.path = character.name;
   source.up = options.up;
   data::PreprocessMode mode;
@@ -74,8 +147,8 @@ data::PreparedCharacter prepare_to_predict(const geometry::Character& character,
   // of the input's skeleton, as the files it is written to do.
   data::PreprocessOptions preprocess = preparation.preprocess;
   preprocess.drop_weightless_leaves = 0;
-  data::PreparedCharacter prepared =
-      data::preprocess(source, preparation.distances, preprocess, mode, &pre);
+  input.prepared = data::preprocess(source, preparation.distances, preprocess, mode, &pre);
+  const data::PreparedCharacter& prepared = input.prepared;
   if (times != nullptr) {
     times->normalise += pre.normalise;
     times->distance += pre.distance;
@@ -92,12 +165,13 @@ data::PreparedCharacter prepare_to_predict(const geometry::Character& character,
       }
     }
   }
-  return prepared;
+  return input;
 }
 
-Prediction finish_prediction(data::PreparedCharacter prepared, const std::string& distance,
+Prediction finish_prediction(PreparedInput input, const std::string& distance,
                              data::RowMatrixXf candidates, double prune, StageTimes* times) {
   auto start = Clock::now();
+  data::PreparedCharacter& prepared = input.prepared;
   const data::DistanceData& d = prepared.distances.at(distance);
   const std::string& name = prepared.name;
   if (candidates.rows() != d.topk_index.rows() || candidates.cols() != d.topk_index.cols()) {
@@ -138,7 +212,11 @@ Prediction finish_prediction(data::PreparedCharacter prepared, const std::string
 
   start = Clock::now();
   out.source_weights = to_source_vertices(out.prepared_weights, prepared.vertex_map);
-  out.joint_weights = joint_weights_of(out.source_weights, prepared.bones, prepared.num_joints());
+  out.joint_weights = onto_input_joints(
+      joint_weights_of(out.source_weights, prepared.bones, prepared.num_joints()),
+      input.input_joints, input.num_input_joints);
+  out.left_out_joints = std::move(input.left_out);
+  out.input_joints = std::move(input.input_joints);
   out.prepared = std::move(prepared);
   if (times != nullptr) times->map_back += seconds_since(start);
   return out;

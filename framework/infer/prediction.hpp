@@ -5,7 +5,7 @@
 /// candidate bones and map the weights back with the same code:
 ///
 /// 1. check the character can be predicted for (size, joints inside the mesh, bones with
-///    length);
+///    length), and leave out the helper ends outside the mesh (IK pole targets, controllers);
 /// 2. the training preprocessing on the fly (data/preprocess.hpp, HeterSkinNet Sec. 4.1:
 ///    normalise, merge, subdivide; the model's distance and its top-K candidate bones, Sec. 3.2;
 ///    one-ring and geodesic edges, Eq. 3), and a check that every candidate is at a finite
@@ -53,24 +53,50 @@ struct PredictOptions {
   /// Inputs with more vertices are refused: the network's memory grows linearly with #V (the
   /// paper's characters have 1K–5K vertices; predict_bench measures the peak at 5K).
   int max_vertices = 50000;
-  /// A joint farther than this fraction of the mesh's bounding-box diagonal outside that box is
-  /// an error: the rig and the mesh do not belong together (other units or another frame).
+  /// A joint farther than this fraction of the mesh's bounding-box diagonal outside that box
+  /// is outside the mesh. An end of the skeleton lying wholly outside (a leaf joint, or a chain
+  /// of them) is a helper that skins nothing: an IK pole target or a controller, which
+  /// Blender's glTF export writes as joints like any bone. It is left out of the prediction
+  /// (weight 0), since its bone from the parent would otherwise compete for the parent's
+  /// vertices. Any other joint outside, or more than half of the joints, is an error: the rig
+  /// and the mesh do not belong together (other units or another frame).
   double max_joint_outside = 0.5;
 };
 
 /// Throws Error naming the character and the element when `character` cannot be predicted
-/// for: more than `options.max_vertices` vertices, a joint outside the mesh (see
-/// PredictOptions::max_joint_outside), or a skeleton of two or more joints that all sit at one
-/// point (every bone has zero length, so no bone has a direction to skin along). Mesh and
-/// skeleton validity (finite, in range, acyclic, one root) are checked when they are loaded.
-void check_predictable(const geometry::Character& character, const PredictOptions& options);
+/// for: more than `options.max_vertices` vertices, a joint outside the mesh that is not a
+/// helper end, or more than half of the joints outside (see PredictOptions::max_joint_outside),
+/// or a skeleton of two or more joints that all sit at one point (every bone has zero length,
+/// so no bone has a direction to skin along). Mesh and skeleton validity (finite, in range,
+/// acyclic, one root) are checked when they are loaded. Returns the helper ends outside the
+/// mesh that a prediction leaves out (joint indices, ascending; usually none).
+std::vector<int> check_predictable(const geometry::Character& character,
+                                   const PredictOptions& options);
+
+/// `character` without the joints `left_out` (check_predictable's helper ends; its weights, if
+/// any, move onto the kept joints, geometry::drop_leaves), and the input index of each joint
+/// kept. Both the prediction and the scoring of a prediction skin this skeleton.
+std::vector<int> without_helper_ends(geometry::Character& character,
+                                     const std::vector<int>& left_out);
+
+/// A character prepared for the network (steps 1–2) and how its joints relate to the input's.
+struct PreparedInput {
+  data::PreparedCharacter prepared;  ///< without the helper ends left out
+  std::vector<int> input_joints;     ///< the input's index of each prepared joint
+  int num_input_joints = 0;
+  std::vector<int> left_out;         ///< the input's helper ends outside the mesh (weight 0)
+};
 
 struct Prediction {
   data::PreparedCharacter prepared;      ///< normalised, merged, subdivided; weights if given
   data::RowMatrixXf candidates;          ///< #V×K network output over prepared.topk_index
   data::RowMatrixXf prepared_weights;    ///< #V×#B at the prepared vertices, pruned
   data::RowMatrixXf source_weights;      ///< #V_in×#B at the input's vertices, pruned
-  geometry::SparseWeights joint_weights; ///< #V_in×#J per-joint weights at the input's vertices
+  /// #V_in×#J per-joint weights at the input's vertices and joints (a left-out joint's column
+  /// is empty)
+  geometry::SparseWeights joint_weights;
+  std::vector<int> left_out_joints;      ///< PreparedInput::left_out
+  std::vector<int> input_joints;         ///< PreparedInput::input_joints
   /// #V×#B ground-truth bone weights at the prepared vertices when the input carried weights
   /// (the bone-level rule of data/preprocess.hpp with the model's distance); 0×0 otherwise
   data::RowMatrixXf prepared_truth;
@@ -85,19 +111,19 @@ struct Preparation {
 };
 
 /// Steps 1–2 of the file comment for `character` (its weights, if any, are ignored by the
-/// prediction and kept in the result for comparison). `times`, if given, receives normalise,
-/// distance and graph. Throws Error naming the character and the element.
-data::PreparedCharacter prepare_to_predict(const geometry::Character& character,
-                                           const Preparation& preparation,
-                                           const PredictOptions& options,
-                                           StageTimes* times = nullptr);
+/// prediction and kept in the result for comparison); helper ends outside the mesh are left
+/// out with a warning naming them. `times`, if given, receives normalise, distance and graph.
+/// Throws Error naming the character and the element.
+PreparedInput prepare_to_predict(const geometry::Character& character,
+                                 const Preparation& preparation, const PredictOptions& options,
+                                 StageTimes* times = nullptr);
 
-/// Step 4: `candidates` (#V×K, the network's softmax over `prepared`'s candidates of
+/// Step 4: `candidates` (#V×K, the network's softmax over `input.prepared`'s candidates of
 /// `distance`) scattered to bones, pruned, checked (every vertex keeps a weight) and mapped
-/// back; `prepared` moves into the result. Throws Error naming `character_name` and the vertex
-/// for a non-finite or negative output or a vertex left without weight. `times->map_back`
-/// receives the mapping back.
-Prediction finish_prediction(data::PreparedCharacter prepared, const std::string& distance,
+/// back to the input's vertices and joints; `input.prepared` moves into the result. Throws
+/// Error naming the character and the vertex for a non-finite or negative output or a vertex
+/// left without weight. `times->map_back` receives the mapping back.
+Prediction finish_prediction(PreparedInput input, const std::string& distance,
                              data::RowMatrixXf candidates, double prune,
                              StageTimes* times = nullptr);
 

@@ -71,10 +71,9 @@ Predictor Predictor::load(const fs::path& dir, const std::string& checkpoint) {
 
 Prediction Predictor::predict(const geometry::Character& character, const PredictOptions& options,
                               StageTimes* times) const {
-  data::PreparedCharacter prepared =
-      infer::prepare_to_predict(character, preparation_, options, times);
+  infer::PreparedInput input = infer::prepare_to_predict(character, preparation_, options, times);
   const auto start = Clock::now();
-  const data::CharacterTensors c = data::to_tensors(prepared, distance());
+  const data::CharacterTensors c = data::to_tensors(input.prepared, distance());
   torch::Tensor candidates;
   {
     torch::NoGradGuard no_grad;
@@ -83,7 +82,7 @@ Prediction Predictor::predict(const geometry::Character& character, const Predic
   train::check_prediction(candidates, c, options_);
   data::RowMatrixXf output = eval::to_eigen(candidates);
   if (times != nullptr) times->network += seconds_since(start);
-  return infer::finish_prediction(std::move(prepared), distance(), std::move(output), options.prune,
+  return infer::finish_prediction(std::move(input), distance(), std::move(output), options.prune,
                                   times);
 }
 
@@ -120,20 +119,24 @@ std::map<std::string, double> Predictor::score(const geometry::Character& truth,
                             truth.name, other.rows(), other.cols(), truth.mesh.num_vertices(),
                             truth.skeleton.num_joints()));
   }
-  check_predictable(truth, options);
   data::PreprocessMode mode;
   mode.laplacian = false;
+  // Both are scored on the skeleton a prediction skins: without the helper ends outside the
+  // mesh (IK targets, controllers; check_predictable), a left-out joint's weight, if any, on its
+  // nearest kept ancestor.
+  geometry::Character base = truth;
+  const std::vector<int> kept =
+      infer::without_helper_ends(base, check_predictable(truth, options));
+  geometry::SparseWeights others = geometry::onto_kept_joints(other, truth.skeleton.parents, kept);
   // The truth decides where the skeleton ends: when the preparation drops its weightless end
   // joints (preprocess's drop_weightless_leaves), the other weights are moved onto the same kept
   // joints, a dropped joint's weight to its nearest kept ancestor (it lies on that ancestor's
   // bone), and both are prepared without dropping, on the same bones. Otherwise a method that
   // weights end joints (Blender does) would be prepared with more bones than the truth.
-  geometry::Character base = truth;
-  geometry::SparseWeights others = other;
   data::PreprocessOptions preprocess = preparation_.preprocess;
   if (data::drops_weightless_leaves(preparation_.preprocess, truth.name)) {
-    const std::vector<int> kept = geometry::drop_weightless_leaves(base);
-    others = geometry::onto_kept_joints(other, truth.skeleton.parents, kept);
+    const std::vector<int> parents = base.skeleton.parents;
+    others = geometry::onto_kept_joints(others, parents, geometry::drop_weightless_leaves(base));
     preprocess.drop_weightless_leaves = 0;
   }
   auto prepare = [&](const geometry::SparseWeights& W) {

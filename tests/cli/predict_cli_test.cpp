@@ -129,6 +129,8 @@ void expect_every_bad_input_fails(const Program& program) {
        {"two_roots_rig.txt", "joint 'other'", "not the root"}},
       {kBad + "box.obj --rig " + kBad + "bone_outside_rig.txt",
        {"bone_outside_rig.txt", "joint 'far'", "outside the mesh's bounding box"}},
+      {kBad + "box.obj --rig " + kBad + "units_rig.txt",
+       {"units_rig.txt", "joint 'hips'", "with 3 of the 4 joints", "does not fit"}},
       {kBad + "box.obj --rig " + kBad + "zero_length_rig.txt",
        {"zero_length_rig.txt", "all 3 joints sit at one point", "zero length"}},
       {kBad + "one_vertex.obj --rig " + kBad + "one_vertex_rig.txt",
@@ -159,6 +161,69 @@ TEST(PredictCli, EveryBadInputIsAOneLineErrorAndLeavesTheOutputAlone) {
 
 TEST(EigenPredictCli, EveryBadInputIsAOneLineErrorAndLeavesTheOutputAlone) {
   expect_every_bad_input_fails(eigen_predict());
+}
+
+/// An IK pole target (a chain of two joints) far outside the box: left out with a warning naming
+/// it; every output still lists every input joint, the left-out ones with no weight, and the
+/// other joints' weights are those of the rig without them.
+void expect_helper_ends_left_out(const Program& program) {
+  TempDir dir;
+  const fs::path glb = dir / "pole.glb", h5 = dir / "pole.h5", rig = dir / "pole_rig.txt";
+  const Result r = program.predict(kBad + "box.obj --rig " + kBad + "box_pole_target_rig.txt" +
+                                   " --out " + glb.string() + " --out " + h5.string() + " --out " +
+                                   rig.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("'knee_pole', 'knee_pole_end' outside the mesh at the end of the skeleton, "
+                       "left out of the prediction with weight 0"),
+            std::string::npos)
+      << r.err;
+  const data::H5Reader file(h5);
+  EXPECT_EQ(file.read_strings("joint_names"),
+            (std::vector<std::string>{"root", "mid", "top", "knee_pole", "knee_pole_end"}));
+  const data::RowMatrixXd joint = file.read_double("joint_weights");
+  ASSERT_EQ(joint.cols(), 5);
+  EXPECT_EQ(joint.rightCols(2).cwiseAbs().maxCoeff(), 0.0);
+  for (Eigen::Index v = 0; v < joint.rows(); ++v) EXPECT_NEAR(joint.row(v).sum(), 1.0, 1e-5);
+  const data::RowMatrixXi bones = file.read_int("bones");
+  EXPECT_LT(bones.maxCoeff(), 3) << "no bone reaches a left-out joint";
+  const geometry::Rig text = geometry::read_rig(rig, 8);
+  EXPECT_EQ(text.skeleton.names, file.read_strings("joint_names"));
+  EXPECT_LT((Eigen::MatrixXd(text.weights) - Eigen::MatrixXd(joint)).cwiseAbs().maxCoeff(), 1e-6);
+  geometry::ImportOptions o;
+  o.join_identical_vertices = false;
+  EXPECT_EQ(geometry::import_character(glb, o).skeleton.num_joints(), 5);
+
+  // The same weights as the rig without the pole target.
+  const fs::path plain = dir / "plain.h5";
+  const Result p = program.predict(kBad + "box.obj --rig " + kBad + "box_rig.txt --out " +
+                                   plain.string());
+  ASSERT_EQ(p.status, 0) << p.err;
+  EXPECT_LT((data::H5Reader(plain).read_double("joint_weights") - joint.leftCols(3))
+                .cwiseAbs()
+                .maxCoeff(),
+            1e-6);
+}
+
+TEST(PredictCli, HelperEndsOutsideTheMeshAreLeftOutWithAWarning) {
+  expect_helper_ends_left_out(skinlab_predict());
+}
+
+// An artist's rig with an IK pole target far outside the mesh is scored on the skeleton a
+// prediction skins (it was refused as a rig that does not fit).
+TEST(PredictCli, ScoreLeavesHelperEndsOutsideTheMeshOut) {
+  TempDir dir;
+  std::string text = read_file(fs::path(SKINLAB_SOURCE_DIR) / kBad / "box_pole_target_rig.txt");
+  for (int v = 0; v < 8; ++v) text += "skin " + std::to_string(v) + (v < 4 ? " root 1\n" : " mid 1\n");
+  const fs::path truth = dir / "truth_rig.txt";
+  write_file_atomic(truth, text);
+  const Result self =
+      run("score " + kBad + "box.obj --rig " + truth.string() + " --weights " + truth.string());
+  ASSERT_EQ(self.status, 0) << self.err;
+  EXPECT_NE(self.out.find("precision 1.0000"), std::string::npos) << self.out;
+}
+
+TEST(EigenPredictCli, HelperEndsOutsideTheMeshAreLeftOutWithAWarning) {
+  expect_helper_ends_left_out(eigen_predict());
 }
 
 TEST(PredictCli, UsageErrorsComeBeforeAnyWork) {

@@ -54,6 +54,26 @@ TEST(DropWeightlessLeaves, WeightlessLeafBesideWeightedOnesGoesTooButNeverTheRoo
   EXPECT_EQ(drop_weightless_leaves(single), std::vector<int>{0});
 }
 
+// Any leaves by a predicate: a chain goes whole, a removable joint above a kept one stays, and
+// weight on a removed joint moves to its nearest kept ancestor; a rig without weights keeps none.
+TEST(DropLeaves, RemovesEndsThePredicateNamesAndMovesTheirWeightUp) {
+  Character c = rig(true);
+  // hand_end2, hand_end and arm are removable; arm has a kept child (hand), so it stays
+  EXPECT_EQ(drop_leaves(c, [](int j) { return j == 1 || j == 3 || j == 4; }),
+            (std::vector<int>{0, 1, 2, 5}));
+  EXPECT_EQ(c.skeleton.parents, (std::vector<int>{-1, 0, 1, 0}));
+  Character weighted = rig(true);
+  weighted.weights.coeffRef(1, 2) = 0.0;
+  weighted.weights.coeffRef(1, 4) = 1.0;  // the vertex of hand now on hand_end2
+  drop_leaves(weighted, [](int j) { return j >= 3 && j <= 4; });
+  EXPECT_EQ(weighted.weights.coeff(1, 2), 1.0) << "hand_end2's weight moves to hand";
+  Character bare = rig(true);
+  bare.weights.resize(0, 0);
+  EXPECT_EQ(drop_leaves(bare, [](int j) { return j == 5; }), (std::vector<int>{0, 1, 2, 3, 4}));
+  EXPECT_EQ(bare.weights.size(), 0);
+  EXPECT_EQ(drop_leaves(bare, [](int) { return false; }).size(), 5u);
+}
+
 // Another method's weights on the end joints the truth drops go to the nearest kept ancestor.
 TEST(OntoKeptJoints, MovesWeightOfRemovedJointsToTheirNearestKeptAncestor) {
   Character truth = rig(true);

@@ -104,7 +104,7 @@ TEST(EigenNetwork, EveryOpPathEqualsLibtorch) {
       "euclidean");
   const geometry::Character character = geometry::import_character(kPlayer);
   const data::PreparedCharacter prepared =
-      infer::prepare_to_predict(character, preparation, {});
+      infer::prepare_to_predict(character, preparation, {}).prepared;
 
   data::RowMatrixXf expected;
   {
