@@ -99,6 +99,7 @@ std::vector<SourceCharacter> Cube2Builder::read(std::vector<Excluded>& excluded)
       excluded.push_back({"cube2", path, e.what()});
       continue;
     }
+    sc.bind = rig.bind;
     sc.character = std::move(rig.character);
     if (!options_.copyright.empty()) {
       const CopyrightInfo info =

@@ -95,6 +95,7 @@ std::vector<SourceCharacter> NexuizBuilder::read(std::vector<Excluded>& excluded
             zym.poses.begin() + scene.first_pose + scene.num_poses);
         sc.animations.push_back(make_animation(scene.name, scene.fps, frames, rig));
       }
+      sc.bind = rig.bind;
       sc.character = std::move(rig.character);
       out.push_back(std::move(sc));
     } catch (const Error& e) {

@@ -444,6 +444,7 @@ std::vector<SourceCharacter> ogre::read_tree(const Tree& tree, const TreeOptions
           stats.dropped_faces, sc.animations.size(),
           skeleton->animations.size(),
           clips_scaled > 0 ? " (" + std::to_string(clips_scaled) + " change a joint's scale: left out)" : "");
+      sc.bind = rig.bind;
       sc.character = std::move(rig.character);
       out.push_back(std::move(sc));
     } catch (const std::exception& e) {  // Error, and e.g. bad_alloc on absurd counts

@@ -208,6 +208,7 @@ std::vector<SourceCharacter> ZeroAdBuilder::read(std::vector<Excluded>& excluded
     ch.skeleton.positions.resize(nb, 3);
     for (int j = 0; j < nb; ++j)
       ch.skeleton.positions.row(j) = pmd.bind[j].translation().transpose();
+    sc.bind = pmd.bind;
     std::vector<Eigen::Triplet<double>> triplets;
     for (Eigen::Index v = 0; v < pmd.bone_indices.rows(); ++v)
       for (int k = 0; k < 4; ++k)

@@ -134,9 +134,11 @@ CorrectiveData::CorrectiveData(const data::Dataset& dataset, const std::string& 
   for (std::size_t i = 0; i < dataset.characters.size(); ++i) {
     const data::PreparedCharacter& c = dataset.characters[i];
     if (c.skeleton != options.skeleton) continue;
-    if (c.animations.empty()) {
-      excluded_.push_back(c.name + ": no clip of its own, so no bind pose to pose it with");
-      spdlog::info("corrective: left out {} ({})", c.name, excluded_.back());
+    const std::vector<float>* bind = c.bind_pose();
+    if (bind == nullptr) {
+      excluded_.push_back(c.name + ": no bind pose in the file (neither its own nor a clip's; a "
+                          "file written before bind poses were stored: re-run `skinlab prepare`)");
+      spdlog::info("corrective: left out {}", excluded_.back());
       continue;
     }
     CorrectiveCharacter out;
@@ -148,9 +150,8 @@ CorrectiveData::CorrectiveData(const data::Dataset& dataset, const std::string& 
     out.joints = c.joints;
     out.normalisation = c.normalisation;
     out.root = static_cast<int>(std::find(c.parents.begin(), c.parents.end(), -1) - c.parents.begin());
-    const data::AnimationData& own = c.animations.front();
     for (int j = 0; j < num_joints_; ++j) {
-      out.bind_inverse.push_back(data::joint_transform(own.bind.data() + static_cast<std::size_t>(j) * 12).inverse());
+      out.bind_inverse.push_back(data::joint_transform(bind->data() + static_cast<std::size_t>(j) * 12).inverse());
     }
     out.mush = std::make_shared<const geometry::DeltaMush>(out.mesh, options.delta_mush, c.name);
     out.one_ring = data::to_long(c.one_ring_edges);
@@ -158,9 +159,13 @@ CorrectiveData::CorrectiveData(const data::Dataset& dataset, const std::string& 
     characters_.push_back(std::move(out));
   }
   if (characters_.empty()) {
-    throw IoError(fmt::format("{}: no character of skeleton family '{}' has a clip of its own to "
-                              "take its bind pose from",
+    throw IoError(fmt::format("{}: no character of skeleton family '{}' has a bind pose in the "
+                              "file (re-run `skinlab prepare` with this build)",
                               file, options.skeleton));
+  }
+  if (clips_.empty()) {
+    throw IoError(fmt::format("{}: no character of skeleton family '{}' has a clip to pose the "
+                              "family with", file, options.skeleton));
   }
 }
 

@@ -27,9 +27,11 @@
 /// at its bind pose and a walk does not walk away (errors are invariant to it; the network's
 /// position inputs would not be).
 ///
-/// A character needs its own bind pose, which the dataset file keeps with its clips: a
-/// character without any clip of its own cannot be posed and is left out, with the reason
-/// (`excluded()`), never posed with another character's bind.
+/// A character is posed with its own bind pose, which the dataset file keeps per character
+/// (PreparedCharacter::bind), so a character without a clip of its own is posed by its family's
+/// clips like the others. A character without a bind pose (a file written before it was stored,
+/// whose characters without clips have none) is left out with the reason (`excluded()`), never
+/// posed with another character's bind.
 ///
 /// Units: the normalised frame is 1 m tall; errors and targets are reported in cm with every
 /// character scaled to `height_m` (1.75 m: the game's units are not metres, and its humans are
@@ -130,8 +132,9 @@ class CorrectiveData {
  public:
   /// Selects the characters of `options.skeleton` in `dataset` (read from `file`, named in
   /// messages), pools their clips and precomputes every character's Delta Mush. Characters of
-  /// other families are ignored; those of the family without a clip are `excluded()`. Throws
-  /// IoError naming the file when the family has no character with a clip, when the family's
+  /// other families are ignored; those of the family without a bind pose are `excluded()`.
+  /// Throws IoError naming the file when the family has no character with a bind pose or no
+  /// clip, when the family's
   /// characters disagree on the joint count or names (naming both characters), or when a clip
   /// has another joint count than the family (naming the clip).
   CorrectiveData(const data::Dataset& dataset, const std::string& file,

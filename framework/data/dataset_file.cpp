@@ -19,6 +19,27 @@ void check_name(const std::filesystem::path& file, const std::string& name) {
   }
 }
 
+/// The per-joint transform arrays hold what their shapes will claim (the writer reads
+/// #J×12 values per pose from them).
+void check_transforms(const std::filesystem::path& file, const PreparedCharacter& c) {
+  const std::size_t per_pose = static_cast<std::size_t>(c.num_joints()) * 12;
+  if (!c.bind.empty() && c.bind.size() != per_pose) {
+    throw IoError(file.string() + ": character '" + c.name + "': bind pose of " +
+                  std::to_string(c.bind.size()) + " values, expected #J×12 = " +
+                  std::to_string(per_pose));
+  }
+  for (const AnimationData& anim : c.animations) {
+    if (anim.bind.size() != per_pose ||
+        anim.frames.size() != per_pose * static_cast<std::size_t>(anim.num_frames)) {
+      throw IoError(file.string() + ": character '" + c.name + "': clip '" + anim.name +
+                    "' holds " + std::to_string(anim.frames.size()) + " frame and " +
+                    std::to_string(anim.bind.size()) + " bind values, expected " +
+                    std::to_string(anim.num_frames) + "×#J×12 and #J×12 (#J = " +
+                    std::to_string(c.num_joints()) + ")");
+    }
+  }
+}
+
 void write_character(H5Writer& w, const PreparedCharacter& c) {
   const std::string g = group_of(c.name);
   w.create_group(g);
@@ -62,6 +83,9 @@ void write_character(H5Writer& w, const PreparedCharacter& c) {
   w.write_attribute(g, "group", c.group.empty() ? c.name : c.group);
   if (c.is_augmented_copy()) w.write_attribute(g, "augmented_from", c.augmented_from);
   w.write_attribute(g, "subdivision_levels", static_cast<std::int64_t>(c.subdivision_levels));
+  if (!c.bind.empty()) {
+    w.write(g + "/bind", {static_cast<std::size_t>(c.num_joints()), 12}, c.bind.data());
+  }
   w.create_group(g + "/animations");
   for (std::size_t a = 0; a < c.animations.size(); ++a) {
     const AnimationData& anim = c.animations[a];
@@ -239,6 +263,15 @@ PreparedCharacter read_character(const H5Reader& r, const std::string& name) {
   }
   c.subdivision_levels = static_cast<int>(r.read_int_attribute(g, "subdivision_levels"));
 
+  if (r.has(g + "/bind")) {
+    std::vector<std::size_t> dims;
+    c.bind = r.read_float_array(g + "/bind", dims);
+    if (dims.size() != 2 || static_cast<long>(dims[0]) != nj || dims[1] != 12) {
+      check.fail(g + "/bind", "expected " + std::to_string(nj) + "×12");
+    }
+    check.finite(g + "/bind", c.bind);
+  }
+
   const std::string animations = g + "/animations";
   if (r.has(animations)) {
     std::vector<std::string> clips = r.children(animations);
@@ -274,6 +307,7 @@ void write_dataset(const std::filesystem::path& file, const Dataset& dataset, in
   std::vector<std::string> name_list;
   for (const auto& c : dataset.characters) {
     check_name(file, c.name);
+    check_transforms(file, c);
     if (!names.insert(c.name).second) {
       throw IoError(file.string() + ": duplicate character name '" + c.name + "'");
     }
@@ -334,6 +368,12 @@ geometry::Skeleton PreparedCharacter::rig() const {
                   "(Skeleton::bones()); re-prepare the dataset with this build");
   }
   return s;
+}
+
+const std::vector<float>* PreparedCharacter::bind_pose() const {
+  if (!bind.empty()) return &bind;
+  if (!animations.empty()) return &animations.front().bind;
+  return nullptr;
 }
 
 Eigen::Isometry3d joint_transform(const float* m) {

@@ -100,12 +100,19 @@ struct PreparedCharacter {
   /// For an augmented training copy (augment.hpp, named "<original>~aug<i>"): the name of the
   /// character it was made from; empty for every other character.
   std::string augmented_from;
+  /// #J × 12 float32 (AnimationData's layout): the bind-pose global joint transforms in the
+  /// normalised frame, whether or not the character has clips; empty when the source gives joint
+  /// positions only, for an augmented copy, and in files written before it was stored (then a
+  /// clip's AnimationData::bind, the same transforms, is the only copy). See bind_pose().
+  std::vector<float> bind;
   std::vector<AnimationData> animations;
 
   bool is_augmented_copy() const { return !augmented_from.empty(); }
   int num_vertices() const { return static_cast<int>(V.rows()); }
   int num_joints() const { return static_cast<int>(joint_names.size()); }
   int num_bones() const { return static_cast<int>(bones.rows()); }
+  /// The bind pose (#J × 12, as `bind`): `bind`, else the first clip's, else nullptr.
+  const std::vector<float>* bind_pose() const;
   /// The character's skeleton (names, parents, joint positions and leaf tips). Validates it and
   /// throws IoError naming the character when its `bones()` are not the stored `bones` (a file
   /// written with another bone convention).
@@ -128,7 +135,8 @@ struct Dataset {
 };
 
 /// Writes `dataset` to `file` atomically. Throws IoError for an invalid character name or a
-/// duplicate name, and on any HDF5 failure (naming the file and the dataset).
+/// duplicate name, a bind pose or clip whose arrays do not hold #J×12 values per pose (naming
+/// the character), and on any HDF5 failure (naming the file and the dataset).
 /// `deflate_level` as H5Writer (0: uncompressed, for intermediate files).
 void write_dataset(const std::filesystem::path& file, const Dataset& dataset,
                    int deflate_level = kDeflateLevel);
@@ -138,8 +146,8 @@ void write_dataset(const std::filesystem::path& file, const Dataset& dataset,
 /// file) or a version other than kFormatVersion (open_dataset_file), a variable-length string,
 /// a missing dataset, a wrong shape, an index out
 /// of range (faces ≥ #V, bones or CSR columns ≥ #J, parents, top-K ≥ #B, edges, Laplacian,
-/// vertex map, split indices ≥ #characters), inconsistent CSR arrays, leaf tips that are not
-/// #J×3, and non-finite values.
+/// vertex map, split indices ≥ #characters), inconsistent CSR arrays, leaf tips or a bind pose
+/// that are not #J×3 / #J×12, and non-finite values.
 Dataset read_dataset(const std::filesystem::path& file);
 
 }  // namespace skinlab::data

@@ -102,10 +102,18 @@ std::vector<float> rows_12(const Eigen::Matrix4d& m) {
   return out;
 }
 
+/// Per-joint global transforms as #J × 12 rows in the normalised frame. Conjugating by the
+/// similarity keeps LBS exact there: (S·T·S⁻¹)(S·B·S⁻¹)⁻¹ = S·(T·B⁻¹)·S⁻¹.
+void append_rows_12(const std::vector<Eigen::Isometry3d>& transforms, const Eigen::Matrix4d& sim,
+                    const Eigen::Matrix4d& inv, std::vector<float>& out) {
+  for (const auto& t : transforms) {
+    const auto m = rows_12(sim * t.matrix() * inv);
+    out.insert(out.end(), m.begin(), m.end());
+  }
+}
+
 AnimationData convert(const datasets::Animation& a, const Eigen::Matrix4d& sim, int num_joints,
                       const std::string& where) {
-  // Conjugating by the similarity keeps LBS exact in the normalised frame:
-  // (S·T·S⁻¹)(S·B·S⁻¹)⁻¹ = S·(T·B⁻¹)·S⁻¹.
   const Eigen::Matrix4d inv = sim.inverse();
   AnimationData out;
   out.name = a.name;
@@ -120,15 +128,9 @@ AnimationData convert(const datasets::Animation& a, const Eigen::Matrix4d& sim, 
       throw Error(where + ": animation '" + a.name + "' has a frame with " +
                   std::to_string(frame.size()) + " joints, expected " + std::to_string(num_joints));
     }
-    for (const auto& t : frame) {
-      const auto m = rows_12(sim * t.matrix() * inv);
-      out.frames.insert(out.frames.end(), m.begin(), m.end());
-    }
+    append_rows_12(frame, sim, inv, out.frames);
   }
-  for (const auto& t : a.bind) {
-    const auto m = rows_12(sim * t.matrix() * inv);
-    out.bind.insert(out.bind.end(), m.begin(), m.end());
-  }
+  append_rows_12(a.bind, sim, inv, out.bind);
   return out;
 }
 
@@ -153,6 +155,7 @@ PreparedCharacter preprocess(const datasets::SourceCharacter& source,
   // clips copied, to follow the kept joints.
   const std::vector<datasets::Animation>* clips = &source.animations;
   std::vector<datasets::Animation> reindexed;
+  std::vector<Eigen::Isometry3d> bind = source.bind;
   if (weighted && drops_weightless_leaves(options, c.name)) {
     const std::vector<int> kept = geometry::drop_weightless_leaves(c);
     const auto keep = [&kept](const std::vector<Eigen::Isometry3d>& per_joint) {
@@ -165,6 +168,7 @@ PreparedCharacter preprocess(const datasets::SourceCharacter& source,
       return out;
     };
     const std::size_t before = source.character.skeleton.names.size();
+    if (bind.size() == before) bind = keep(bind);
     reindexed = source.animations;
     for (auto& a : reindexed) {  // a clip of another size stays as it is (reported below)
       if (a.bind.size() != before) continue;
@@ -279,7 +283,15 @@ PreparedCharacter preprocess(const datasets::SourceCharacter& source,
   out.licence = source.licence;
   out.attribution = source.attribution;
   out.skeleton = source.skeleton;
-  if (mode.augment_copy < 0) {
+  if (mode.augment_copy < 0) {  // an augmented copy is not in its source's bind pose
+    if (!bind.empty()) {
+      if (static_cast<int>(bind.size()) != c.skeleton.num_joints()) {
+        throw Error(where + ": " + std::to_string(bind.size()) + " bind-pose transforms for " +
+                    std::to_string(c.skeleton.num_joints()) + " joints");
+      }
+      const Eigen::Matrix4d sim_matrix = sim.matrix();
+      append_rows_12(bind, sim_matrix, sim_matrix.inverse(), out.bind);
+    }
     for (const auto& a : *clips) {
       out.animations.push_back(convert(a, sim.matrix(), c.skeleton.num_joints(), where));
     }

@@ -37,6 +37,11 @@ struct SourceCharacter {
   /// The up direction of the character's frame; preprocessing rotates it to +Y (normalize.hpp),
   /// e.g. +Z for the Quake-lineage formats IQM and ZYM.
   Eigen::Vector3d up = Eigen::Vector3d::UnitY();
+  /// bind[j]: joint j's bind-pose global transform (the frame of `character`), as Animation::bind
+  /// but kept whether or not the character has a clip, so that another clip of its skeleton
+  /// family can pose it (DenseGATs' corrective task). Empty when the source gives joint positions
+  /// only (OBJ + rig text, assimp imports).
+  std::vector<Eigen::Isometry3d> bind;
   std::vector<Animation> animations;
 };
 

@@ -83,6 +83,7 @@ inline data::PreparedCharacter tiny_character(const std::string& name) {
   for (int i = 0; i < 2 * 3 * 12; ++i) a.frames.push_back(0.01f * i);
   for (int i = 0; i < 3 * 12; ++i) a.bind.push_back(-0.02f * i);
   c.animations.push_back(a);
+  c.bind = a.bind;
   return c;
 }
 
@@ -119,6 +120,7 @@ inline void expect_equal(const data::PreparedCharacter& a, const data::PreparedC
   EXPECT_EQ(a.attribution, b.attribution);
   EXPECT_EQ(a.skeleton, b.skeleton);
   EXPECT_EQ(a.augmented_from, b.augmented_from);
+  EXPECT_EQ(a.bind, b.bind);
   ASSERT_EQ(a.animations.size(), b.animations.size());
   for (std::size_t i = 0; i < a.animations.size(); ++i) {
     EXPECT_EQ(a.animations[i].name, b.animations[i].name);

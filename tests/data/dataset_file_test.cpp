@@ -25,6 +25,7 @@ data::Dataset tiny_dataset() {
   data::Dataset d;
   d.characters = {testing::tiny_character("alpha"), testing::tiny_character("beta")};
   d.characters[1].animations.clear();
+  d.characters[1].bind.clear();  // an augmented copy has no bind pose of its own
   d.characters[1].distances["hollow_dist"] = d.characters[1].distances["euclidean"];
   // beta's leaf bones have extent (format version 2); alpha keeps the paper's zero-length ones.
   d.characters[1].leaf_tips = d.characters[1].joints;
@@ -117,6 +118,42 @@ TEST(DatasetFile, LeafTipsOfTheWrongShapeNameTheDataset) {
   data::write_dataset(dir / "t.h5", d);
   expect_error<IoError>([&] { data::read_dataset(dir / "t.h5"); },
                         {"t.h5", "'/characters/beta/leaf_tips'"});
+}
+
+TEST(DatasetFile, TheBindPoseIsKeptWithOrWithoutClipsAndCheckedForShape) {
+  TempDir dir;
+  data::Dataset d = tiny_dataset();
+  d.characters[0].animations.clear();  // a character without a clip keeps its bind pose
+  data::write_dataset(dir / "b.h5", d);
+  const auto r = data::read_dataset(dir / "b.h5");
+  ASSERT_EQ(r.characters[0].bind.size(), 36u);
+  ASSERT_NE(r.characters[0].bind_pose(), nullptr);
+  EXPECT_EQ(*r.characters[0].bind_pose(), d.characters[0].bind);
+  EXPECT_EQ(r.characters[1].bind_pose(), nullptr);  // neither its own nor a clip's
+
+  // A file without per-character bind poses (written before they were stored): a clip's.
+  data::PreparedCharacter old = testing::tiny_character("old");
+  old.bind.clear();
+  ASSERT_NE(old.bind_pose(), nullptr);
+  EXPECT_EQ(old.bind_pose(), &old.animations.front().bind);
+
+  // The writer refuses a bind pose of the wrong size, naming the character; nothing is left.
+  data::Dataset bad = d;
+  bad.characters[0].bind.pop_back();
+  expect_error<IoError>([&] { data::write_dataset(dir / "bad.h5", bad); },
+                        {"bad.h5", "character 'alpha'", "bind pose of 35 values"});
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad.h5"));
+  // The reader names a stored bind pose of the wrong shape.
+  {
+    H5::H5File f((dir / "b.h5").string(), H5F_ACC_RDWR);
+    f.unlink("/characters/alpha/bind");
+    const hsize_t dims[2] = {2, 12};
+    const std::vector<float> values(24, 0.5f);
+    f.createDataSet("/characters/alpha/bind", H5::PredType::NATIVE_FLOAT, H5::DataSpace(2, dims))
+        .write(values.data(), H5::PredType::NATIVE_FLOAT);
+  }
+  expect_error<IoError>([&] { data::read_dataset(dir / "b.h5"); },
+                        {"b.h5", "'/characters/alpha/bind'", "expected 3×12"});
 }
 
 TEST(DatasetFile, RealCharacterArraysAreChunkedAndCompressed) {
@@ -281,6 +318,7 @@ TEST(DatasetFile, ReadableByH5py) {
             "dataset characters/<name>/V\n"
             "dataset characters/<name>/animations/<k>/bind\n"
             "dataset characters/<name>/animations/<k>/frames\n"
+            "dataset characters/<name>/bind\n"
             "dataset characters/<name>/bones\n"
             "dataset characters/<name>/distances/<type>/D\n"
             "dataset characters/<name>/distances/<type>/targets\n"

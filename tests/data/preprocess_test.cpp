@@ -205,6 +205,8 @@ TEST(PreprocessLeaves, DroppedWeightlessEndJointsTakeTheirClipTransformsWithThem
   sk.positions.conservativeResize(sk.num_joints(), 3);
   sk.positions.row(sk.num_joints() - 1) = sk.positions.row(leaf);
   extra.character.weights.conservativeResize(extra.character.weights.rows(), sk.num_joints());
+  ASSERT_EQ(extra.bind.size(), static_cast<std::size_t>(sk.num_joints() - 1));
+  extra.bind.push_back(extra.bind[static_cast<std::size_t>(leaf)]);
   for (auto& a : extra.animations) {
     a.bind.push_back(a.bind[static_cast<std::size_t>(leaf)]);
     for (auto& frame : a.frames) frame.push_back(frame[static_cast<std::size_t>(leaf)]);
@@ -223,6 +225,9 @@ TEST(PreprocessLeaves, DroppedWeightlessEndJointsTakeTheirClipTransformsWithThem
   for (std::size_t i = 0; i < a.animations.size(); ++i) {
     EXPECT_EQ(a.animations[i].bind.size(), static_cast<std::size_t>(12 * a.num_joints()));
   }
+  // The character's own bind pose follows the kept joints too, and equals its clips'.
+  EXPECT_EQ(a.bind, a.animations.front().bind);
+  EXPECT_EQ(b.bind, b.animations.front().bind);
   // Extended leaf bones: tips for every joint, some leaf reaching beyond its joint.
   ASSERT_EQ(a.leaf_tips.rows(), a.num_joints());
   EXPECT_GT((a.leaf_tips - a.joints).rowwise().norm().maxCoeff(), 0.01);

@@ -147,6 +147,11 @@ TEST(Ogre, AnimationsPoseTheCharacterInOnePiece) {
   for (const SourceCharacter& sc : characters) {
     const geometry::Character& c = sc.character;
     ASSERT_EQ(sc.animations.size(), 2u) << sc.path;
+    // The character's own bind pose (kept with or without clips) is its clips' bind.
+    ASSERT_EQ(sc.bind.size(), static_cast<std::size_t>(c.skeleton.num_joints())) << sc.path;
+    for (std::size_t j = 0; j < sc.bind.size(); ++j) {
+      EXPECT_TRUE(sc.bind[j].isApprox(sc.animations.front().bind[j], 0.0)) << sc.path << " " << j;
+    }
     for (const Animation& a : sc.animations) {
       EXPECT_DOUBLE_EQ(a.fps, 24.0);
       ASSERT_GT(a.frames.size(), 1u) << sc.path << " " << a.name;

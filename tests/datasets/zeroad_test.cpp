@@ -313,6 +313,15 @@ TEST(ZeroAdBuilder, AttachesActorClips) {
   EXPECT_FALSE(built().get("wolf").animations.empty());
   EXPECT_FALSE(built().get("m_tunic_short").animations.empty());
   EXPECT_TRUE(built().get("cattle_male_a").animations.empty());  // no actor names it
+  // Every character keeps its PMD's bind pose, with or without clips.
+  for (const auto& sc : built().characters) {
+    ASSERT_EQ(sc.bind.size(), static_cast<std::size_t>(sc.character.skeleton.num_joints()))
+        << sc.character.name;
+    const Pmd pmd = read_pmd(read_bundled(sc.path), sc.path);
+    for (std::size_t j = 0; j < sc.bind.size(); ++j) {
+      EXPECT_TRUE(sc.bind[j].isApprox(pmd.bind[j], 0.0)) << sc.character.name << " " << j;
+    }
+  }
 }
 
 TEST(ZeroAdLbs, BindPoseReproducesEveryMesh) {

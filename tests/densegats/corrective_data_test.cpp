@@ -132,18 +132,50 @@ TEST_F(CorrectiveDataTest, PosesAreStridedAndCapped) {
   EXPECT_EQ(CorrectiveData(*dataset_, file_, capped).characters()[0].poses.size(), 10u);
 }
 
-TEST_F(CorrectiveDataTest, CharactersWithoutAClipAreLeftOutWithTheReason) {
+TEST_F(CorrectiveDataTest, EveryCharacterKeepsItsOwnBindPoseInTheFile) {
+  for (const auto& c : dataset_->characters) {
+    ASSERT_EQ(c.bind.size(), static_cast<std::size_t>(12 * c.num_joints())) << c.name;
+    ASSERT_FALSE(c.animations.empty()) << c.name;
+    // The same transforms as its clips carry (both from the PMD's bind pose).
+    EXPECT_EQ(c.bind, c.animations.front().bind) << c.name;
+    // Stored conjugated into the normalised frame (N·B·N⁻¹), so each maps the image of the
+    // source frame's origin, N·0, to its joint: N·B·N⁻¹·(N·0) = N·(B·0).
+    const Eigen::Vector3d origin = c.normalisation.topRightCorner<3, 1>();
+    for (int j = 0; j < c.num_joints(); ++j) {
+      const Eigen::Vector3d at = data::joint_transform(c.bind.data() + 12 * j) * origin;
+      EXPECT_LT((at - c.joints.row(j).transpose()).norm(), 1e-5) << c.name << " joint " << j;
+    }
+  }
+}
+
+TEST_F(CorrectiveDataTest, ACharacterWithoutAClipIsPosedByItsFamilysClipsWithItsOwnBindPose) {
+  const CorrectiveData all(*dataset_, file_, options());
   data::Dataset copy = *dataset_;
   const std::string name = copy.characters[0].name;
   copy.characters[0].animations.clear();
   const CorrectiveData data(copy, file_, options());
-  EXPECT_EQ(data.characters().size(), 2u);
-  ASSERT_EQ(data.excluded().size(), 1u);
-  EXPECT_NE(data.excluded()[0].find(name + ": no clip of its own"), std::string::npos);
+  ASSERT_EQ(data.characters().size(), 3u);
+  EXPECT_TRUE(data.excluded().empty());
+  const CorrectiveCharacter& without = data.characters()[0];
+  EXPECT_EQ(without.name, name);
+  EXPECT_EQ(without.poses.size(), data.characters()[1].poses.size());
+  for (std::size_t j = 0; j < without.bind_inverse.size(); ++j) {
+    EXPECT_TRUE(without.bind_inverse[j].isApprox(all.characters()[0].bind_inverse[j], 1e-12)) << j;
+  }
+
+  // Without any bind pose (a file written before they were stored), it is left out, named.
+  copy.characters[0].bind.clear();
+  const CorrectiveData left_out(copy, file_, options());
+  EXPECT_EQ(left_out.characters().size(), 2u);
+  ASSERT_EQ(left_out.excluded().size(), 1u);
+  EXPECT_NE(left_out.excluded()[0].find(name + ": no bind pose in the file"), std::string::npos);
 
   for (auto& c : copy.characters) c.animations.clear();
   expect_error<IoError>([&] { CorrectiveData(copy, file_, options()); },
                         {file_, "no character of skeleton family 'Biped' has a clip"});
+  for (auto& c : copy.characters) c.bind.clear();
+  expect_error<IoError>([&] { CorrectiveData(copy, file_, options()); },
+                        {file_, "no character of skeleton family 'Biped' has a bind pose"});
   CorrectiveOptions horse = options();
   horse.skeleton = "Horse";
   expect_error<IoError>([&] { CorrectiveData(*dataset_, file_, horse); },
