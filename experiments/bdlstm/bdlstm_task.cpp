@@ -25,8 +25,9 @@ class SequenceTaskTrainer final : public task::TaskTrainer {
   train::TrainResult fit(const RunDir& run, const train::FitLimits& limits) override {
     return trainer_.fit(run, limits);
   }
-  /// The paper has no validation set: best.pt is chosen on the training loss.
-  bool validated() const override { return false; }
+  /// Whether best.pt is chosen on the validation windows (sequences.val_fraction > 0; the paper
+  /// has no validation set), else on the training loss.
+  bool validated() const override { return trainer_.has_validation(); }
 
  private:
   SequenceTrainer trainer_;

@@ -28,6 +28,13 @@ SequenceOptions SequenceOptions::from(const config::Node& node, std::vector<std:
   f.optional("min_frames", o.min_frames).check(o.min_frames >= 2, "min_frames", "must be ≥ 2");
   f.optional("test_fraction", o.test_fraction)
       .check(o.test_fraction > 0 && o.test_fraction < 1, "test_fraction", "must be in (0, 1)");
+  f.optional("val_fraction", o.val_fraction)
+      .check(std::isfinite(o.val_fraction) && o.val_fraction >= 0, "val_fraction",
+             "must be ≥ 0 (0: no validation window)");
+  f.check(o.val_fraction + o.test_fraction < 1, "val_fraction",
+          fmt::format("val_fraction + test_fraction = {} + {} must be < 1 (the rest of each "
+                      "sequence is for training)",
+                      o.val_fraction, o.test_fraction));
   std::int64_t seed = 0;
   f.optional("seed", seed).check(seed >= 0, "seed", "must be ≥ 0");
   o.seed = static_cast<std::uint64_t>(seed);
@@ -56,6 +63,16 @@ std::pair<int, int> held_out_window(int frames, double fraction, std::uint64_t s
   z ^= z >> 31;
   const int begin = static_cast<int>(z % static_cast<std::uint64_t>(frames - length + 1));
   return {begin, begin + length};
+}
+
+std::optional<std::pair<int, int>> validation_window(int frames, std::pair<int, int> test,
+                                                     double fraction) {
+  if (fraction <= 0) return std::pair{0, 0};
+  const int length = std::max(1, static_cast<int>(std::lround(fraction * frames)));
+  if ((test.second - test.first) + length > frames - 1) return std::nullopt;
+  if (test.first >= length) return std::pair{test.first - length, test.first};
+  if (test.second + length <= frames) return std::pair{test.second, test.second + length};
+  return std::nullopt;
 }
 
 SequenceData::SequenceData(const data::Dataset& dataset, const std::string& file,
@@ -110,7 +127,8 @@ SequenceData::SequenceData(const data::Dataset& dataset, const std::string& file
       }
       add_sequence(out, std::move(s));
     }
-    add_character(std::move(out), "no clip with at least min_frames sampled frames");
+    add_character(std::move(out), "no clip with at least min_frames sampled frames and room for its "
+                                  "held-out windows");
   }
   finish();
 }
@@ -228,7 +246,8 @@ SequenceData::SequenceData(const SequenceOptions& options) : options_(options), 
       }
       add_sequence(out, std::move(s));
     }
-    add_character(std::move(out), "no clip with at least min_frames frames");
+    add_character(std::move(out), "no clip with at least min_frames frames and room for its held-out "
+                                  "windows");
   }
   finish();
 }
@@ -239,9 +258,22 @@ void SequenceData::add_sequence(SequenceCharacter& out, MeshSequence s) {
                                     s.clip, s.num_frames(), options_.min_frames));
     return;
   }
-  s.features = out.acap->encode_sequence(s.positions);
-  std::tie(s.test_begin, s.test_end) =
+  const std::pair<int, int> test =
       held_out_window(s.num_frames(), options_.test_fraction, options_.seed, out.name + "/" + s.clip);
+  const std::optional<std::pair<int, int>> val =
+      validation_window(s.num_frames(), test, options_.val_fraction);
+  if (!val) {
+    excluded_.push_back(fmt::format(
+        "{}/{}: {} sampled frames, no room for a validation window of {} frame(s) (val_fraction = "
+        "{}) beside its test window {}..{} (test_fraction = {}) with a training frame left",
+        out.name, s.clip, s.num_frames(),
+        std::max(1, static_cast<int>(std::lround(options_.val_fraction * s.num_frames()))),
+        options_.val_fraction, test.first, test.second - 1, options_.test_fraction));
+    return;
+  }
+  std::tie(s.test_begin, s.test_end) = test;
+  std::tie(s.val_begin, s.val_end) = *val;
+  s.features = out.acap->encode_sequence(s.positions);
   out.sequences.push_back(std::move(s));
 }
 
@@ -256,8 +288,9 @@ void SequenceData::add_character(SequenceCharacter out, const std::string& why_e
 void SequenceData::finish() {
   for (const std::string& e : excluded_) spdlog::info("sequences: left out {}", e);
   if (characters_.empty()) {
-    throw IoError(fmt::format("{}: no character with a clip of at least {} sampled frames", source_,
-                              options_.min_frames));
+    throw IoError(fmt::format("{}: no character with a clip of at least {} sampled frames and room "
+                              "for its held-out windows",
+                              source_, options_.min_frames));
   }
 }
 

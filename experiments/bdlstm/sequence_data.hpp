@@ -25,15 +25,25 @@
 /// does not make integrable. Sequence errors should be read against it.
 ///
 /// Split (Sec. 4.1: "we randomly exclude a subsequence, which takes up 20% of the dataset, as a
-/// test set"): in each sequence a contiguous window of round(test_fraction · frames) frames
-/// (at least 1) at a random start, drawn from the seed and the character and clip names, so it
-/// does not depend on which other characters or clips the file holds.
+/// test set"): in each sequence a contiguous test window of round(test_fraction · frames)
+/// frames (at least 1) at a random start, drawn from the seed and the character and clip names,
+/// so it does not depend on which other characters or clips the file holds. The paper has no
+/// validation set; ours (not in the paper, for choosing best.pt and early stopping) is a second
+/// contiguous window of round(val_fraction · frames) frames (at least 1) right next to the test
+/// window: immediately before it where it fits, else immediately after it. The test window is
+/// drawn as without validation, so it does not move with val_fraction and test numbers stay
+/// comparable; val_fraction 0 is the paper's split. The training frames are the rest: at most
+/// two stretches, before and after the two held-out windows. A sequence without room for both
+/// windows and a training frame is left out with the reason, as a short one is.
 
 #include <torch/torch.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "framework/core/config.hpp"
@@ -50,6 +60,8 @@ namespace skinlab::bdlstm {
 ///       frame_stride: 1       # every k-th frame (Sec. 4: every other model for slow motion)
 ///       min_frames: 8         # clips with fewer sampled frames are left out, with the reason
 ///       test_fraction: 0.2    # the held-out subsequence of each sequence (Sec. 4.1)
+///       val_fraction: 0.1     # a validation window beside it (best.pt, early stopping); 0: none,
+///                             # the paper's split (val_fraction + test_fraction < 1)
 ///       seed: 0               # draws the held-out windows
 ///       folder: ""            # a folder of OBJ sequences instead of the dataset file (below)
 ///       up: [0, 1, 0]         # a folder's up axis (its meshes are turned to Y up)
@@ -60,6 +72,7 @@ struct SequenceOptions {
   int frame_stride = 1;
   int min_frames = 8;
   double test_fraction = 0.2;
+  double val_fraction = 0.1;
   std::uint64_t seed = 0;
   /// Decodes and checks the section (every field optional); errors name the file, line, key.
   /// `other_keys` are accepted and left to the caller (the task's own keys, sequence_task.hpp).
@@ -72,8 +85,16 @@ struct MeshSequence {
   double fps = 0;                          ///< of the sampled frames (clip fps / stride; 0: unknown)
   std::vector<Eigen::MatrixXd> positions;  ///< #V×3 per frame, normalised frame (metres, 1 m tall)
   std::vector<Eigen::MatrixXd> features;   ///< #V×9 ACAP features per frame w.r.t. the template
-  int test_begin = 0, test_end = 0;        ///< held-out frames [test_begin, test_end)
+  int test_begin = 0, test_end = 0;        ///< held-out test frames [test_begin, test_end)
+  /// Validation frames [val_begin, val_end), adjacent to the test window (before it where it
+  /// fits); empty (0, 0) when val_fraction is 0.
+  int val_begin = 0, val_end = 0;
   int num_frames() const { return static_cast<int>(positions.size()); }
+  /// The frames held out from training, test and validation together: one contiguous span.
+  std::pair<int, int> held_out() const {
+    if (val_begin == val_end) return {test_begin, test_end};
+    return {std::min(test_begin, val_begin), std::max(test_end, val_end)};
+  }
 };
 
 struct SequenceCharacter {
@@ -106,10 +127,11 @@ class SequenceData {
   explicit SequenceData(const SequenceOptions& options);
 
   /// Builds the sequences of every selected character of `dataset` (read from `file`, named in
-  /// messages). A character without clips, and a clip with fewer than `min_frames` sampled
-  /// frames, is left out with the reason (`excluded()`). Throws IoError naming the file for a
-  /// character name it does not hold, a clip whose joint count is not the character's (naming
-  /// both), or when nothing is left.
+  /// messages). A character without clips, a clip with fewer than `min_frames` sampled frames,
+  /// and a clip without room for its test and validation windows and a training frame
+  /// (validation_window), is left out with the reason (`excluded()`). Throws IoError naming the
+  /// file for a character name it does not hold, a clip whose joint count is not the
+  /// character's (naming both), or when nothing is left.
   SequenceData(const data::Dataset& dataset, const std::string& file,
                const SequenceOptions& options);
 
@@ -121,8 +143,8 @@ class SequenceData {
   const std::vector<std::string>& excluded() const { return excluded_; }
 
  private:
-  /// Encodes `positions`, draws its held-out window and adds it to `out`, or records it as
-  /// excluded when it has fewer than min_frames frames.
+  /// Draws the held-out windows of `sequence`, encodes its positions and adds it to `out`, or
+  /// records it as excluded when it has fewer than min_frames frames or no room for the windows.
   void add_sequence(SequenceCharacter& out, MeshSequence sequence);
   /// Keeps `out` if it has a sequence (else records why not); throws when nothing is left.
   void add_character(SequenceCharacter out, const std::string& why_empty);
@@ -140,5 +162,12 @@ class SequenceData {
 /// splitmix64 step).
 std::pair<int, int> held_out_window(int frames, double fraction, std::uint64_t seed,
                                     const std::string& key);
+
+/// The validation window [begin, end) of a sequence of `frames` frames whose test window is
+/// `test` (held_out_window): round(fraction · frames) frames, at least 1, immediately before
+/// the test window when it fits there, else immediately after it. Empty, (0, 0), for fraction 0;
+/// nullopt when the window fits on neither side or the two windows leave no training frame.
+std::optional<std::pair<int, int>> validation_window(int frames, std::pair<int, int> test,
+                                                     double fraction);
 
 }  // namespace skinlab::bdlstm

@@ -59,8 +59,9 @@ Eigen::MatrixXd to_matrix(const torch::Tensor& t) {
       c.data_ptr<double>(), c.size(0), c.size(1));
 }
 
-/// Frames outside the held-out window, for the feature scale.
-std::vector<Eigen::MatrixXd> training_frames(const SequenceCharacter& c) {
+/// Frames outside the test window (training and validation frames), for the feature scale: it
+/// does not depend on val_fraction, so a run's scale is the same with or without validation.
+std::vector<Eigen::MatrixXd> scale_frames(const SequenceCharacter& c) {
   std::vector<Eigen::MatrixXd> out;
   for (const MeshSequence& s : c.sequences) {
     for (int t = 0; t < s.num_frames(); ++t) {
@@ -91,7 +92,8 @@ SequenceTaskOptions SequenceTaskOptions::from(const config::Node& node) {
   std::vector<std::string> task_keys(std::begin(kTaskKeys), std::end(kTaskKeys));
   o.data = SequenceOptions::from(node, task_keys);
   config::Fields f(node, "sequences",
-                   {"characters", "frame_stride", "min_frames", "test_fraction", "seed", "folder", "up"});
+                   {"characters", "frame_stride", "min_frames", "test_fraction", "val_fraction", "seed",
+                    "folder", "up"});
   f.optional("window", o.window).check(o.window >= 2, "window", "must be ≥ 2 frames");
   f.optional("batch", o.batch).check(o.batch >= 1, "batch", "must be ≥ 1");
   f.optional("iterations_per_epoch", o.iterations_per_epoch)
@@ -144,7 +146,7 @@ SequenceConfig SequenceConfig::from(const config::Config& config) {
 ScaledCharacter scale_character(const SequenceCharacter& character) {
   ScaledCharacter out;
   out.character = &character;
-  out.scale = geometry::FeatureScale::fit(training_frames(character));
+  out.scale = geometry::FeatureScale::fit(scale_frames(character));
   for (const MeshSequence& s : character.sequences) {
     std::vector<torch::Tensor> frames;
     for (const Eigen::MatrixXd& f : s.features) frames.push_back(to_tensor(out.scale.normalise(f)));
@@ -220,19 +222,22 @@ SequenceTrainer::SequenceTrainer(const config::Config& config)
   data_ = make_data(options_);
   const SequenceCharacter& ch = data_->characters().front();
   scaled_ = scale_character(ch);
-  // Training stretches: the frames before and after each held-out window.
+  // Training stretches: the frames before and after each sequence's held-out windows (the test
+  // and validation windows are adjacent: one span).
   std::vector<std::pair<int, std::pair<int, int>>> stretches;
   int longest = 0;
   for (std::size_t s = 0; s < ch.sequences.size(); ++s) {
     const MeshSequence& q = ch.sequences[s];
-    for (const auto& [a, b] : {std::pair{0, q.test_begin}, std::pair{q.test_end, q.num_frames()}}) {
+    const auto [held_begin, held_end] = q.held_out();
+    for (const auto& [a, b] : {std::pair{0, held_begin}, std::pair{held_end, q.num_frames()}}) {
       if (b - a >= 2) stretches.push_back({static_cast<int>(s), {a, b}});
       longest = std::max(longest, b - a);
     }
   }
   if (longest < 2) {
     throw IoError(data_->source() + ": character '" + ch.name +
-                  "' has no two consecutive training frames outside its held-out windows");
+                  "' has no two consecutive training frames outside its held-out (test and "
+                  "validation) windows");
   }
   length_ = std::min(options_.sequences.window, longest);
   for (const auto& [s, range] : stretches) {
@@ -243,16 +248,69 @@ SequenceTrainer::SequenceTrainer(const config::Config& config)
   } else {
     net_ = build_network(options_, ch);
   }
+  // Validation: each clip's validation window, whole (a bdlstm rollout needs 2 frames).
+  const int shortest = net_ ? 2 : 1;
+  int skipped = 0;
+  for (std::size_t s = 0; s < ch.sequences.size(); ++s) {
+    const MeshSequence& q = ch.sequences[s];
+    if (q.val_begin == q.val_end) continue;
+    if (q.val_end - q.val_begin < shortest) {
+      ++skipped;
+      continue;
+    }
+    validation_windows_.push_back({static_cast<int>(s), q.val_begin, q.val_end});
+    std::vector<torch::Tensor> frames;
+    for (int t = q.val_begin; t < q.val_end; ++t) {
+      frames.push_back(scaled_.frames[s][static_cast<std::size_t>(t)].unsqueeze(0));
+    }
+    validation_.push_back(std::move(frames));
+  }
+  if (skipped > 0) {
+    spdlog::info("sequence task: {} clip(s) of '{}' have a 1-frame validation window, with nothing "
+                 "for a rollout to predict; they are left out of the validation loss",
+                 skipped, ch.name);
+  }
   train::check_checkpointable(model());
   initial_torch_rng_ = train::get_rng_state(at::detail::getDefaultCPUGenerator());
   optimizer_ = std::make_unique<torch::optim::Adam>(
       model().parameters(), torch::optim::AdamOptions(options_.run.train.lr));
   std::int64_t count = 0;
   for (const auto& p : model().parameters()) count += p.numel();
-  spdlog::info("sequence task: '{}' ({} vertices), {} clips, {} training windows of {} frames; "
-               "{} network, {} parameters",
+  int validation_frames = 0;
+  for (const Span& v : validation_windows_) validation_frames += v.end - v.begin;
+  spdlog::info("sequence task: '{}' ({} vertices), {} clips, {} training windows of {} frames, "
+               "{} validation windows ({} frames); {} network, {} parameters",
                ch.name, ch.num_vertices(), ch.sequences.size(), windows_.size(), length_,
+               validation_windows_.size(), validation_frames,
                net_ ? "bdlstm/" + net_->options().scheme : std::string("mesh_vae"), count);
+}
+
+double SequenceTrainer::validation_loss(std::map<std::string, double>* parts) {
+  if (validation_.empty()) return std::nan("");
+  torch::nn::Module& m = model();
+  const bool was_training = m.is_training();
+  m.eval();
+  torch::NoGradGuard no_grad;
+  const Objective& objective = options_.sequences.objective;
+  std::map<std::string, double> sums;
+  if (vae_) {  // every validation frame reconstructed on its own, as in training
+    std::vector<torch::Tensor> frames;
+    for (const auto& window : validation_) frames.insert(frames.end(), window.begin(), window.end());
+    vae_loss(*vae_, torch::cat(frames), objective, &sums);
+  } else {  // each window one rollout (batch of 1), the mean over the windows
+    for (const auto& window : validation_) {
+      sequence_loss(*net_, net_->rollout(window), window, objective, &sums);
+    }
+    for (auto& [name, value] : sums) value /= static_cast<double>(validation_.size());
+  }
+  m.train(was_training);
+  if (parts) {
+    for (const auto& [name, value] : sums) (*parts)[name] += value;
+  }
+  // Selection is on how well unseen frames are reproduced: the reconstruction term alone. L_2
+  // is a norm of the parameters and L_KL a regulariser; neither measures the frames, and on
+  // windows of a few frames L_2 alone would outweigh the rest.
+  return sums.at("recon");
 }
 
 double SequenceTrainer::iterate(at::Generator& rng, std::map<std::string, double>& parts) {
@@ -299,6 +357,13 @@ train::TrainResult SequenceTrainer::fit(const RunDir& run, const train::FitLimit
   train::TrainingState& state = begun.state;
   result.resumed = begun.resumed;
   const fs::path last = run.file(train::kLastCheckpoint);
+  const bool have_val = has_validation();
+  if (!have_val) {
+    spdlog::warn("{}: no validation window{}: best.pt and early stopping use the train loss",
+                 data_->source(),
+                 options_.sequences.data.val_fraction > 0 ? " of 2 frames or more"
+                                                          : " (sequences.val_fraction is 0)");
+  }
   auto stopped_early = [&] {
     return t.patience > 0 && state.best_epoch > 0 && state.epoch - state.best_epoch >= t.patience;
   };
@@ -322,14 +387,18 @@ train::TrainResult SequenceTrainer::fit(const RunDir& run, const train::FitLimit
     }
     const double train_loss = sum / iterations;
     for (auto& [name, value] : parts) value /= iterations;
-    const bool improved = train::record_epoch(state, epoch, train_loss, t.min_delta);
+    std::map<std::string, double> val_parts;
+    const double val_loss = have_val ? validation_loss(&val_parts) : std::nan("");
+    const double selection = have_val ? val_loss : train_loss;
+    const bool improved = train::record_epoch(state, epoch, selection, t.min_delta);
     state.torch_rng = train::get_rng_state(torch_rng);
     state.order_rng = train::get_rng_state(order_rng);
     const double seconds = seconds_since(epoch_start);
     run.append_metrics({{"epoch", epoch},
                         {"train_loss", train_loss},
                         {"train_parts", train::parts_json(parts)},
-                        {"val_loss", nlohmann::json()},
+                        {"val_loss", have_val ? nlohmann::json(val_loss) : nlohmann::json()},
+                        {"val_parts", train::parts_json(val_parts)},
                         {"best_epoch", state.best_epoch},
                         {"best_loss", state.best_loss},
                         {"improved", improved},
@@ -340,8 +409,11 @@ train::TrainResult SequenceTrainer::fit(const RunDir& run, const train::FitLimit
     ++result.epochs_this_call;
     const double eta = seconds_since(session_start) / result.epochs_this_call *
                        static_cast<double>(t.epochs - epoch);
-    spdlog::info("{}: train loss {:.5g} ({}) | {:.1f} s, ETA {}{}", label, train_loss,
-                 train::parts_text(parts), seconds, train::duration(eta), improved ? " *best*" : "");
+    spdlog::info("{}: train loss {:.5g} ({}){} | {:.1f} s, ETA {}{}", label, train_loss,
+                 train::parts_text(parts),
+                 have_val ? fmt::format(", val loss {:.5g} ({})", val_loss, train::parts_text(val_parts))
+                          : std::string(),
+                 seconds, train::duration(eta), improved ? " *best*" : "");
     if (limits.stop_after_epochs > 0 && result.epochs_this_call >= limits.stop_after_epochs &&
         state.epoch < t.epochs) {
       result.interrupted = true;

@@ -15,13 +15,15 @@
 ///       horizons: [5, 10, 15]    # Table 1: the 5th, 10th, 15th generated frame
 ///       baseline: ""             # or acap_extrapolation ([24]) / hold, instead of a model
 ///
-/// Features are scaled into [−0.95, 0.95] per (vertex, dimension) over the character's training
-/// frames (acap.hpp's FeatureScale); the network sees and predicts scaled features.
+/// Features are scaled into [−0.95, 0.95] per (vertex, dimension) over the character's frames
+/// outside its test windows (acap.hpp's FeatureScale): the training and validation frames, so
+/// that the scale, and with it every trained run, does not depend on val_fraction. The network
+/// sees and predicts scaled features.
 ///
 /// Training (Sec. 3.3-3.4, 4.1): each iteration draws `batch` windows of `window` consecutive
-/// training frames (never crossing a held-out window; shorter when no training stretch is that
-/// long), runs the forward chain from each window's first frame and the backward chain from its
-/// last, free-running, and minimises Eq. 3:
+/// training frames (never crossing a test or validation window; shorter when no training
+/// stretch is that long), runs the forward chain from each window's first frame and the
+/// backward chain from its last, free-running, and minimises Eq. 3:
 ///
 ///     L = recon · L_recon + bidir · L_bidir + kl · L_KL + l2 · L_2
 ///     L_recon = Σ_{i=2..L} ‖S^f_i − X_i‖ + ‖S^b_i − X_{L+1−i}‖                   (Eq. 4)
@@ -33,12 +35,26 @@
 /// trainable parameter. The paper's α2 = 0.1 weighs L_KL + L_2, so both weights are 0.1 here;
 /// "w/o L_KL" (Table 2) sets kl: 0. The unidirectional scheme has no backward chain, so no
 /// backward reconstruction and no L_bidir. Adam (`train.lr`, default Adam β; Sec. 4.1).
-/// An epoch is `iterations_per_epoch` iterations; the paper trains 7,000 iterations. There is
-/// no validation set (the paper has none): best.pt is the epoch of lowest training loss.
+/// An epoch is `iterations_per_epoch` iterations; the paper trains 7,000 iterations.
 /// A `mesh_vae` model trains on the same windows' frames, each reconstructed on its own
 /// (vae_loss), for the same iterations.
 ///
-/// Evaluation (Table 1): only on the held-out windows (part `test`). Every start a of a window
+/// Validation (not in the paper, which has no validation set): after each epoch the
+/// reconstruction term on the validation windows (sequence_data.hpp, `sequences.val_fraction`),
+/// with the model in eval mode (z = μ, so nothing random and no generator advanced): Eq. 4 on
+/// each clip's validation window as one free-running rollout (a window of one frame has nothing
+/// to predict and is skipped), averaged over the clips; for a `mesh_vae`, vae_loss's
+/// reconstruction term on all validation frames. The other terms of Eq. 3 are logged beside it
+/// (`val_parts`) but not selected on: L_2 is a norm of the parameters and L_KL a regulariser, and
+/// on windows of a few frames L_2 alone outweighs the reconstruction. best.pt is the epoch of
+/// lowest validation loss, and `train.patience` stops training after
+/// that many epochs without improvement (by more than `train.min_delta`), as in the other tasks.
+/// The test windows are never used in training or selection. Without validation windows
+/// (val_fraction 0, the paper's setting) best.pt and early stopping follow the training loss,
+/// with a warning.
+///
+/// Evaluation (Table 1): only on the test windows (part `test`; not the validation windows,
+/// which selected the checkpoint). Every start a of a window
 /// with the last initial frame l = a + 2 inside it gives up to three predictions of frame l + h
 /// for each horizon h with l + h inside the window:
 ///  - the network with u ∈ `initial_frames` initial frames X_{l−u+1..l} (metric `e<h>_<u>if_mm`);
@@ -103,7 +119,8 @@ struct SequenceConfig {
   static SequenceConfig from(const config::Config& config);
 };
 
-/// A character's sequences in the network's units: the scale fitted over its training frames.
+/// A character's sequences in the network's units: the scale fitted over its frames outside the
+/// test windows (training and validation frames; see the file comment).
 struct ScaledCharacter {
   const SequenceCharacter* character = nullptr;
   geometry::FeatureScale scale;
@@ -147,6 +164,19 @@ class SequenceTrainer {
   const std::vector<std::pair<int, int>>& windows() const { return windows_; }
   int window_length() const { return length_; }
 
+  /// Frames [begin, end) of the character's sequence `sequence`.
+  struct Span {
+    int sequence = 0, begin = 0, end = 0;
+  };
+  /// What the validation loss is computed on: each clip's validation window (for a bdlstm, those
+  /// of at least 2 frames). Empty without validation.
+  const std::vector<Span>& validation_windows() const { return validation_windows_; }
+  bool has_validation() const { return !validation_windows_.empty(); }
+  /// The reconstruction term on the validation windows (see the file comment), deterministic,
+  /// in eval mode without gradients (the model's mode is restored); adds the mean of each part
+  /// of Eq. 3 to `parts` when given. NaN without validation.
+  double validation_loss(std::map<std::string, double>* parts = nullptr);
+
  private:
   double iterate(at::Generator& rng, std::map<std::string, double>& parts);
 
@@ -155,6 +185,9 @@ class SequenceTrainer {
   ScaledCharacter scaled_;
   std::vector<std::pair<int, int>> windows_;
   int length_ = 0;
+  std::vector<Span> validation_windows_;
+  /// Scaled frames of validation_windows_, each L × [1×V×9].
+  std::vector<std::vector<torch::Tensor>> validation_;
   std::shared_ptr<SequenceNet> net_;
   std::shared_ptr<MeshVae> vae_;
   std::unique_ptr<torch::optim::Adam> optimizer_;

@@ -2,7 +2,8 @@
 // a horse, a wolf and three bipeds with their game clips): every character with clips is in,
 // the rest left out with the reason; frames are the engine's skinning of the clip; the ACAP
 // features of every real frame decode back to it; rotations stay continuous from frame to
-// frame; the held-out windows are 20 % of each sequence, reproducible and seed-dependent.
+// frame; the held-out windows are 20 % of each sequence, reproducible and seed-dependent; the
+// validation window sits right beside the test window, which does not move with val_fraction.
 #include "experiments/bdlstm/sequence_data.hpp"
 
 #include <gtest/gtest.h>
@@ -144,6 +145,64 @@ TEST_F(BundledSequences, HeldOutWindowsAreAFifthReproducibleAndSeeded) {
   EXPECT_EQ(held_out_window(2, 0.2, 3, "x").second - held_out_window(2, 0.2, 3, "x").first, 1);
 }
 
+// The validation window (sequences.val_fraction): round(val_fraction · frames) frames right
+// before the test window where they fit, else right after it; the test window is drawn as
+// without validation, so val_fraction 0 reproduces it and today's split exactly.
+TEST_F(BundledSequences, ValidationWindowSitsBesideAnUnmovedTestWindow) {
+  SequenceOptions none = options(), tenth = options(), quarter = options();
+  none.val_fraction = 0;
+  quarter.val_fraction = 0.25;
+  const SequenceData a(*dataset_, file_, none), b(*dataset_, file_, tenth), c(*dataset_, file_, quarter);
+  ASSERT_EQ(a.characters().size(), b.characters().size());
+  ASSERT_EQ(a.characters().size(), c.characters().size());
+  int before = 0, after = 0;
+  for (std::size_t i = 0; i < a.characters().size(); ++i) {
+    ASSERT_EQ(a.characters()[i].sequences.size(), b.characters()[i].sequences.size());
+    ASSERT_EQ(a.characters()[i].sequences.size(), c.characters()[i].sequences.size());
+    for (std::size_t k = 0; k < a.characters()[i].sequences.size(); ++k) {
+      const MeshSequence& q0 = a.characters()[i].sequences[k];
+      EXPECT_EQ(q0.val_begin, 0);
+      EXPECT_EQ(q0.val_end, 0);
+      EXPECT_EQ(q0.held_out(), std::make_pair(q0.test_begin, q0.test_end));
+      for (const auto& [split, fraction] : {std::pair{&b, 0.1}, std::pair{&c, 0.25}}) {
+        const MeshSequence& q = split->characters()[i].sequences[k];
+        const int n = q.num_frames();
+        const std::string where = q.clip + " val_fraction " + std::to_string(fraction);
+        ASSERT_EQ(q.clip, q0.clip);
+        EXPECT_EQ(q.test_begin, q0.test_begin) << where;
+        EXPECT_EQ(q.test_end, q0.test_end) << where;
+        const int length = std::max(1, static_cast<int>(std::lround(fraction * n)));
+        EXPECT_EQ(q.val_end - q.val_begin, length) << where;
+        EXPECT_GE(q.val_begin, 0) << where;
+        EXPECT_LE(q.val_end, n) << where;
+        EXPECT_TRUE(q.val_end <= q.test_begin || q.val_begin >= q.test_end) << where;  // disjoint
+        if (q.test_begin >= length) {
+          EXPECT_EQ(q.val_end, q.test_begin) << where;  // right before it when it fits
+          ++before;
+        } else {
+          EXPECT_EQ(q.val_begin, q.test_end) << where;  // else right after it
+          ++after;
+        }
+        EXPECT_EQ(q.held_out(), std::make_pair(std::min(q.val_begin, q.test_begin),
+                                               std::max(q.val_end, q.test_end)));
+        EXPECT_LT(q.held_out().second - q.held_out().first, n) << where;  // training frames remain
+        EXPECT_TRUE(q.features == q0.features) << where;
+      }
+    }
+  }
+  EXPECT_GT(before, 0);
+  EXPECT_GT(after, 0);  // some test window starts too early for the validation window before it
+
+  EXPECT_EQ(validation_window(50, {10, 20}, 0.1), std::make_pair(5, 10));
+  EXPECT_EQ(validation_window(50, {2, 12}, 0.1), std::make_pair(12, 17));
+  EXPECT_EQ(validation_window(50, {10, 20}, 0.001), std::make_pair(9, 10));  // at least 1 frame
+  EXPECT_EQ(validation_window(50, {10, 20}, 0), std::make_pair(0, 0));
+  EXPECT_EQ(validation_window(10, {2, 8}, 0.3), std::nullopt);   // 3 frames fit on neither side
+  EXPECT_EQ(validation_window(10, {0, 5}, 0.5), std::nullopt);   // no training frame left
+  EXPECT_EQ(validation_window(10, {0, 5}, 0.4), std::make_pair(5, 9));
+  EXPECT_EQ(validation_window(2, {1, 2}, 0.1), std::nullopt);
+}
+
 TEST_F(BundledSequences, SelectionShortClipsAndErrors) {
   SequenceOptions o = options();
   o.characters = {"wolf"};
@@ -161,6 +220,21 @@ TEST_F(BundledSequences, SelectionShortClipsAndErrors) {
   expect_error<ConfigError>(
       [] { SequenceOptions::from(config::Config::parse("{frame_stride: 0}", "s.yaml").root()); },
       {"frame_stride"});
+  expect_error<ConfigError>(
+      [] { SequenceOptions::from(config::Config::parse("{val_fraction: -0.1}", "s.yaml").root()); },
+      {"s.yaml", "val_fraction", "≥ 0"});
+  expect_error<ConfigError>(
+      [] {
+        SequenceOptions::from(
+            config::Config::parse("{test_fraction: 0.6, val_fraction: 0.4}", "s.yaml").root());
+      },
+      {"s.yaml", "val_fraction", "test_fraction", "< 1"});
+  const auto parse = [](const std::string& yaml) {
+    return SequenceOptions::from(config::Config::parse(yaml, "s.yaml").root());
+  };
+  EXPECT_EQ(SequenceOptions{}.val_fraction, 0.1);
+  EXPECT_EQ(parse("{val_fraction: 0}").val_fraction, 0);
+  EXPECT_EQ(parse("{test_fraction: 0.3, val_fraction: 0.1}").val_fraction, 0.1);
   expect_error<ConfigError>(
       [] { SequenceOptions::from(config::Config::parse("{frames: 3}", "s.yaml").root()); },
       {"frames"});
@@ -265,6 +339,28 @@ TEST(FolderSequences, FramesThatAreNotTheTemplatesMeshAreNamed) {
   std::swap(flipped.F(3, 1), flipped.F(3, 2));
   geometry::write_obj(folder / "sheet/wave/05.obj", flipped);
   expect_error<IoError>([&] { SequenceData{o}; }, {"05.obj", "face 3", "fixed connectivity"});
+  // A clip too short for a test window, a validation window and a training frame is left out
+  // with the reason, as one shorter than min_frames is; without validation it is kept.
+  std::filesystem::create_directories(folder / "sheet/zz_tiny");
+  for (int t = 0; t < 2; ++t) geometry::write_obj(folder / fmt::format("sheet/zz_tiny/{}.obj", t), grid);
+  std::filesystem::remove(folder / "sheet/wave/05.obj");
+  geometry::write_obj(folder / "sheet/wave/05.obj", grid);
+  o.min_frames = 2;
+  const SequenceData tiny_out(o);
+  ASSERT_EQ(tiny_out.characters().at(0).sequences.size(), 1u);
+  EXPECT_EQ(tiny_out.characters()[0].sequences[0].clip, "wave");
+  ASSERT_EQ(tiny_out.excluded().size(), 1u);
+  for (const char* part : {"sheet/zz_tiny", "2 sampled frames", "validation window of 1", "val_fraction",
+                           "training frame"}) {
+    EXPECT_NE(tiny_out.excluded()[0].find(part), std::string::npos) << tiny_out.excluded()[0];
+  }
+  o.val_fraction = 0;
+  const SequenceData tiny_in(o);
+  ASSERT_EQ(tiny_in.characters().at(0).sequences.size(), 2u);
+  EXPECT_TRUE(tiny_in.excluded().empty());
+  o.val_fraction = 0.1;
+  o.min_frames = 4;
+
   o.folder = (folder / "missing").string();
   expect_error<IoError>([&] { SequenceData{o}; }, {"missing", "not a directory"});
   o.folder = folder.path().string();
