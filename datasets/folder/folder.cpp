@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <limits>
@@ -48,6 +49,11 @@ Folder::Options Folder::Options::from(const config::Node& node) {
       if (o.exclude.back().second.empty()) exclude[pattern].fail("the reason must not be empty");
     }
   }
+  f.optional("animations", o.animations);
+  f.optional("max_animations_per_character", o.max_animations_per_character);
+  f.optional("fps", o.fps);
+  f.check(o.max_animations_per_character >= 0, "max_animations_per_character", "must be ≥ 0");
+  f.check(std::isfinite(o.fps) && o.fps > 0, "fps", "must be a positive number of frames per second");
   for (const auto& p : o.include) f.check(!p.empty(), "include", "a pattern must not be empty");
   for (auto& p : o.include) p = strip_slashes(p);
   f.finish();
@@ -108,9 +114,13 @@ bool is_assimp_character(const std::string& ext) {
   return kExtensions.count(ext) > 0;
 }
 
-/// Rotates V and joint positions so that `up` becomes +Y (the smallest rotation; 180° about X
-/// for −Y), as NormalizeOptions::source_up would.
-void rotate_to_y_up(geometry::Character& c, const Eigen::Vector3d& up) {
+/// Rotates V, joint positions and the joints' bind and clip transforms so that `up` becomes +Y
+/// (the smallest rotation; 180° about X for −Y), as NormalizeOptions::source_up would. The
+/// transforms are conjugated, T ↦ R·T·R⁻¹ (as preprocessing conjugates by its similarity), so
+/// that (R·F·R⁻¹)(R·B·R⁻¹)⁻¹ = R·(F·B⁻¹)·R⁻¹ poses the rotated mesh exactly as F·B⁻¹ posed the
+/// original, and bind translations stay the rotated joint positions.
+void rotate_to_y_up(geometry::Character& c, geometry::ImportedMotion& motion,
+                    const Eigen::Vector3d& up) {
   const Eigen::Vector3d u = up.normalized();
   if ((u - Eigen::Vector3d::UnitY()).norm() < 1e-12) return;
   const Eigen::Matrix3d R =
@@ -119,6 +129,15 @@ void rotate_to_y_up(geometry::Character& c, const Eigen::Vector3d& up) {
           : Eigen::Quaterniond::FromTwoVectors(u, Eigen::Vector3d::UnitY()).toRotationMatrix();
   c.mesh.V = c.mesh.V * R.transpose();
   c.skeleton.positions = c.skeleton.positions * R.transpose();
+  Eigen::Isometry3d rotation = Eigen::Isometry3d::Identity();
+  rotation.linear() = R;
+  const Eigen::Isometry3d inverse = rotation.inverse();
+  for (auto& T : motion.bind) T = rotation * T * inverse;
+  for (auto& clip : motion.clips) {
+    for (auto& frame : clip.frames) {
+      for (auto& T : frame) T = rotation * T * inverse;
+    }
+  }
 }
 
 /// Divides every weight row by its sum; returns how many rows were off 1 by more than 1e-3
@@ -231,14 +250,44 @@ std::vector<SourceCharacter> Folder::read(std::vector<Excluded>& excluded) const
         if (model.model.joint_names.empty()) throw geometry::GeometryError(relative + ": no joints (a rigid prop)");
         if (!model.has_blend_weights) throw geometry::GeometryError(relative + ": no blend indexes/weights");
         model.model.name = relative;
-        c = to_source_rig(model.model).character;
+        SourceRig source_rig = to_source_rig(model.model);
+        c = std::move(source_rig.character);
+        s.bind = std::move(source_rig.bind);
         s.up = Eigen::Vector3d::UnitZ();  // the Quake lineage's up axis (cube2.hpp)
       } else {
         geometry::ImportOptions import;
         import.weights = keep_sums;
+        if (options_.animations) {
+          import.clip_fps = options_.fps;
+          import.max_clips = options_.max_animations_per_character;
+        }
         geometry::ImportReport report;
-        c = geometry::import_character(file, import, &report);
-        if (report.source_up) rotate_to_y_up(c, *report.source_up);
+        geometry::ImportedMotion motion;
+        c = geometry::import_character(file, import, &report, &motion);
+        if (report.source_up) rotate_to_y_up(c, motion, *report.source_up);
+        if (!motion.no_bind.empty()) {
+          spdlog::warn("{}: {}: no bind pose{}: {}", label, relative,
+                       options_.animations ? " and no clips" : "", motion.no_bind);
+        }
+        s.bind = motion.bind;
+        for (auto& clip : motion.clips) {
+          s.animations.push_back({clip.name, clip.fps, std::move(clip.frames), motion.bind});
+        }
+        if (options_.animations) {
+          spdlog::info("{}: {}: {} of {} clips kept{}{}", label, relative, s.animations.size(),
+                       motion.num_file_clips,
+                       motion.left_out.empty()
+                           ? std::string()
+                           : ", " + std::to_string(motion.left_out.size()) + " left out (" +
+                                 std::to_string(motion.num_scaled_clips) + " scale a joint)",
+                       motion.num_unread_clips > 0
+                           ? ", " + std::to_string(motion.num_unread_clips) +
+                                 " not read (max_animations_per_character)"
+                           : std::string());
+          for (const auto& why : motion.left_out) {
+            spdlog::debug("{}: {}: clip {} left out", label, relative, why);
+          }
+        }
       }
       if (c.has_weights()) {
         const auto [off, worst] = renormalise(c.weights);

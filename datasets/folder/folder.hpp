@@ -42,6 +42,26 @@
 /// read_obj_rig would renormalise silently or reject the file). FBX files that declare another
 /// up axis (ImportReport::source_up) are rotated to Y up here, since SourceCharacter carries no
 /// up axis for assimp files; the normalisation of preprocessing then only scales and translates.
+///
+/// Bind pose and clips. Every assimp character gets SourceCharacter::bind, its joints'
+/// bind-pose global transforms (geometry::ImportedMotion: B(bone) = G(mesh node) ·
+/// mOffsetMatrix⁻¹, rigid once the hierarchy's uniform scale is divided out; IQM files get theirs
+/// from their joints). With `animations: true` (default false, so existing configs build the
+/// same files), an assimp file's skeletal clips become SourceCharacter::animations as `ogre`
+/// reads OGRE's: in file order, sampled at `fps` (default 24) from 0 to the clip's duration, up
+/// to `max_animations_per_character` (default 8) kept; frames[f][j] is joint j's node's animated
+/// global transform, so that LBS with frames[f][j] · bind[j]⁻¹ is the skinning an assimp or glTF
+/// viewer draws (geometry/import_character.hpp derives it). A clip that changes a joint's scale
+/// relative to the bind pose (by more than 1e-4, relative) cannot be written as rigid transforms
+/// and is left out; so is one that animates no joint (morph-target clips). A file whose bind
+/// transforms are not rigid up to one uniform scale per joint (a mirror, a non-uniform scale) or
+/// whose meshes bind a joint differently keeps its character without bind and clips. Each file's
+/// kept and left-out clips are logged. Unweighted vertices rigidly attached to a joint through the
+/// node hierarchy move with it from where the hierarchy places them, which is off the bind pose
+/// when the file stores its nodes in another pose (ImportReport::max_rigid_misplacement, logged
+/// as a warning). The rotation to Y up above applies to bind and frames too,
+/// by conjugation (R·T·R⁻¹), so LBS stays exact in the rotated frame. IQM clips are not read here
+/// (the `cube2` builder reads Cube 2's).
 
 #include <filesystem>
 #include <string>
@@ -70,6 +90,11 @@ class Folder final : public DatasetBuilder {
     std::vector<std::string> include;  ///< glob patterns relative to `path`; empty: every file
     /// (pattern, reason) pairs in config order: matching files become Excluded with the reason.
     std::vector<std::pair<std::string, std::string>> exclude;
+    /// Read the skeletal clips of assimp files (see the file comment). Off by default, unlike
+    /// `ogre`'s, so that configs written before clips were read give the same dataset files.
+    bool animations = false;
+    int max_animations_per_character = 8;  ///< clips kept per character, in file order; ≥ 0
+    double fps = 24;                       ///< sampling rate of the clips; > 0
     static Options from(const config::Node& node);
   };
 

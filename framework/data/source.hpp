@@ -40,7 +40,8 @@ struct SourceCharacter {
   /// bind[j]: joint j's bind-pose global transform (the frame of `character`), as Animation::bind
   /// but kept whether or not the character has a clip, so that another clip of its skeleton
   /// family can pose it (DenseGATs' corrective task). Empty when the source gives joint positions
-  /// only (OBJ + rig text, assimp imports).
+  /// only (OBJ + rig text) or an assimp file's bind transforms are not rigid up to a uniform
+  /// scale (geometry::ImportedMotion::no_bind).
   std::vector<Eigen::Isometry3d> bind;
   std::vector<Animation> animations;
 };

@@ -65,6 +65,61 @@
 /// ≤ 0, and glTF2 drops JOINTS_0 indices beyond the skin's joint list, before we see them; the
 /// vertex keeps its other weights and renormalisation scales them to sum 1.
 ///
+/// Bind transforms and clips (ImportedMotion, only when asked for). The bind-pose global
+/// transform of joint j, in the same frame, is
+///     bind(j) = B(bone) = G(N) · inverse(mOffsetMatrix)   for a bone (the first mesh's, as above),
+///     bind(j) = G(node)                                    for a joint that is no bone,
+/// so that bind(j).translation() is the joint's position. A viewer (assimp's, or glTF's, which
+/// ignores the skinned mesh node's transform) draws a vertex v of mesh m (node N) skinned to
+/// bone node J at time t at Σ w · G_t(J) · mOffsetMatrix · v, where G_t is the global transform
+/// with the clip's local transforms in place of mTransformation on the animated nodes. Since the
+/// character holds V = G(N)·v and inverse(bind(j)) = mOffsetMatrix · inverse(G(N)), this is
+///     G_t(J) · inverse(bind(j)) · V,
+/// i.e. LBS of the returned mesh with frame(j, t) = G_t(J) and bind(j): joint j's frame at time t
+/// is its node's animated global transform in the file's world frame. Assimp's mesh-space
+/// skinning matrix inverse(G(N)) · G_t(J) · mOffsetMatrix is the same transform conjugated into
+/// mesh space, and the mesh node's own animation cancels out of it. The bind pose this returns
+/// is what a viewer draws at rest only where G_rest(J) = bind(j); a file whose inverse bind
+/// matrices are relative to the world (glTF's rule) under a scaled mesh node has bind(j) =
+/// G(N) · G_rest(J), and its clips then scale every joint relative to the bind by G(N)'s scale
+/// and are left out (below): Godot's platformer player.glb, mesh node at scale 0.3.
+///
+/// Rigidly attached vertices (weight 1 on their host joint, above) are placed by their mesh
+/// node's G(N), i.e. in the node hierarchy's stored pose, and a viewer moves them with G_t(N).
+/// LBS with the host's bind(j) = B(bone) reproduces that only where B(bone) = G(host node) (the
+/// hierarchy is stored in the bind pose) and no node between host and mesh node is animated;
+/// otherwise the attachment is moved rigidly with its host but keeps the offset it has in the
+/// returned bind pose, ImportReport::max_rigid_misplacement. (Quaternius' astronauts' pistol, a
+/// mesh node under a finger bone, lies 2.6 units, 0.45 of the bounding-box diagonal, from the
+/// bind-pose hand; moving it there would change characters read before clips were.)
+///
+/// Rigid transforms. Hierarchies often scale uniformly above the skeleton (an armature node at
+/// scale 0.01 or 100); a joint's global transform then is s·R plus a translation. Since
+/// (s·R_t, t_t) · (s·R_b, t_b)⁻¹ = (R_t, t_t) · (R_b, t_b)⁻¹, dividing the same s out of bind and
+/// frames leaves LBS unchanged, so both are returned as rotations (the nearest rotation, U·Vᵀ of
+/// the SVD) and translations. A joint whose bind transform is not a rotation with a uniform
+/// positive scale (to ImportOptions::clip_scale_tolerance, relative; non-uniform scale, shear,
+/// a mirror) makes the bind unrepresentable: bind and clips stay empty and ImportedMotion::
+/// no_bind says why. The same holds when two meshes bind one bone differently (their B(bone)
+/// differ by more than bind_pose_tolerance of the diagonal in translation or clip_scale_tolerance
+/// in the linear part), since one bind per joint could not pose both meshes' vertices.
+///
+/// Sampling (ImportOptions::clip_fps > 0): clips in the file's order (aiScene::mAnimations),
+/// each sampled at clip_fps from time 0 to its duration (aiAnimation::mDuration ticks at
+/// mTicksPerSecond, 25 when 0), floor(duration·fps) + 1 frames. A node with a channel
+/// (aiNodeAnim, matched by name, the first of several) gets the local transform T·R·S from its
+/// position, rotation and scaling keys, each interpolated between the two keys around the time
+/// (linearly for vectors, slerp for quaternions) and held constant before the first and after the
+/// last key (glTF's and assimp's viewer behaviour; mPreState/mPostState are not read); a channel
+/// without keys of one kind takes that part from the node's mTransformation; a node without a
+/// channel keeps mTransformation. Assimp 5.2 does not keep glTF's STEP and CUBICSPLINE
+/// interpolation (it stores the key values only), so such samplers are interpolated linearly.
+/// A clip is left out, and counted, when at some frame a joint's scale differs from its bind
+/// scale by more than clip_scale_tolerance (relative; any singular value of the global linear
+/// part, or a mirror): its frames would not be rigid relative to the bind pose. It is also left
+/// out when no channel animates a joint or a node above one (morph-target or prop clips), or
+/// when its keys or duration are not finite or keys are out of time order.
+///
 /// Format quirk (B3D): assimp's B3D importer converts the left-handed Blitz3D data to its
 /// right-handed convention by mirroring Z (MakeLeftHanded) and flipping the winding, so node
 /// rotations of Minetest's player model come out as 180° turns (diag(-1,1,-1) or diag(-1,-1,1))
@@ -72,9 +127,12 @@
 /// offsets and node transforms agree (see above), and the mesh is upright with Y up, feet at y=0.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "framework/geometry/skin_weights.hpp"
 
@@ -88,6 +146,14 @@ struct ImportOptions {
   double bind_pose_tolerance = 1e-4;
   /// Passed to check_weights after merging (renormalise: rows are divided by their sum).
   WeightCheck weights{1e-3, true};
+  /// With an ImportedMotion to fill: sample the file's clips at this many frames per second;
+  /// 0 reads bind transforms only. Must be finite and ≥ 0.
+  double clip_fps = 0;
+  /// Stop after this many clips have been kept (left-out clips do not count). Must be ≥ 0.
+  int max_clips = std::numeric_limits<int>::max();
+  /// Relative tolerance on scales: of a joint's bind transform (uniform to this) and of its
+  /// frames (equal to the bind scale to this), see the file comment.
+  double clip_scale_tolerance = 1e-4;
 };
 
 /// What the import found, for logs and tests.
@@ -98,21 +164,54 @@ struct ImportReport {
   /// Largest |B(bone) translation − G(bone node) translation| over bones and meshes, file units.
   double max_bind_pose_mismatch = 0;
   std::string max_bind_pose_mismatch_joint;  ///< where it occurs ("" if no bone)
+  /// Largest distance, in file units, between an unweighted (rigidly attached) vertex x and
+  /// where its host joint's bind pose would carry it, |B(host) · G(host node)⁻¹ · x − x|: zero
+  /// when the host node is stored in the bind pose. The vertex is not moved (see the file
+  /// comment, "Bind transforms and clips"); logged as a warning above bind_pose_tolerance.
+  double max_rigid_misplacement = 0;
+  std::string max_rigid_misplacement_joint;  ///< its host joint ("" if no rigid vertex)
   /// The up direction the file declares through assimp's metadata "UpAxis"/"UpAxisSign"
   /// (set by the FBX importer, which does not rotate the scene itself); empty when absent.
   /// Pass it to NormalizeOptions::source_up.
   std::optional<Eigen::Vector3d> source_up;
 };
 
+/// One clip of the file, sampled (see the file comment).
+struct ImportedClip {
+  std::string name;  ///< aiAnimation::mName, "clip<k>" when empty (k: its index in the file)
+  double fps = 0;    ///< ImportOptions::clip_fps
+  /// frames[f][j]: joint j's global transform at time f / fps, rigid (the uniform scale of its
+  /// bind transform divided out), in the returned character's frame and units.
+  std::vector<std::vector<Eigen::Isometry3d>> frames;
+};
+
+/// The joints' bind-pose transforms and sampled clips, for LBS with frame · bind⁻¹ (the file
+/// comment derives them).
+struct ImportedMotion {
+  /// bind[j]: joint j's bind-pose global transform, rigid; translation = skeleton position j.
+  /// Empty when no_bind is set.
+  std::vector<Eigen::Isometry3d> bind;
+  std::string no_bind;  ///< why bind (and with it every clip) is empty; "" otherwise
+  std::vector<ImportedClip> clips;  ///< the kept clips, in file order
+  int num_file_clips = 0;    ///< aiScene::mNumAnimations
+  int num_scaled_clips = 0;  ///< left out: a joint's scale changes (or mirrors)
+  int num_unread_clips = 0;  ///< not looked at: max_clips were kept before them
+  /// Every left-out clip as "'<name>': <reason>", scaled ones included, for the log.
+  std::vector<std::string> left_out;
+};
+
 /// Reads `file` and returns its character (name = file stem) in the bind pose, in the file's
-/// world frame and units, with weights #V×#J checked and renormalised.
+/// world frame and units, with weights #V×#J checked and renormalised. With `motion`, also the
+/// joints' bind transforms and (ImportOptions::clip_fps > 0) the file's clips.
 ///
 /// Throws skinlab::IoError naming the file if it does not exist or assimp cannot read it (with
 /// assimp's message), and GeometryError naming the file for: no mesh, no bones, a bone without a
 /// node of the same name, a bone vertex index out of range or a negative / non-finite weight
 /// (naming mesh, bone and vertex), an unweighted vertex outside the skeleton (naming mesh and
-/// vertex), and anything Character::validate rejects.
+/// vertex), and anything Character::validate rejects. A negative or non-finite clip_fps or a
+/// negative max_clips is a GeometryError naming the file. Problems of the motion (no_bind,
+/// left-out clips) are reported in `motion`, not thrown: the character itself is still good.
 Character import_character(const std::filesystem::path& file, const ImportOptions& options = {},
-                           ImportReport* report = nullptr);
+                           ImportReport* report = nullptr, ImportedMotion* motion = nullptr);
 
 }  // namespace skinlab::geometry

@@ -1,9 +1,11 @@
 #pragma once
 // A minimal glTF 2.0 writer for import tests: meshes with optional skin attributes, skins with
-// inverse bind matrices, and nodes given as JSON objects by the test, all in one .gltf file with
-// an embedded base64 buffer (spec: https://registry.khronos.org/glTF/specs/2.0/glTF-2.0.html).
+// inverse bind matrices, node animations, and nodes given as JSON objects by the test, all in
+// one .gltf file with an embedded base64 buffer
+// (spec: https://registry.khronos.org/glTF/specs/2.0/glTF-2.0.html).
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <string>
@@ -24,11 +26,26 @@ struct GltfSkin {
   std::vector<Eigen::Matrix4f> inverse_bind;  // one per joint, as ordinary (row, col) matrices
 };
 
+// One animated property of one node: key times (seconds) and values (3 floats per key for
+// "translation" and "scale", 4 for "rotation", a quaternion x, y, z, w), one sampler each.
+struct GltfChannel {
+  int node = 0;
+  std::string path;  // "translation", "rotation" or "scale"
+  std::vector<float> times;
+  std::vector<float> values;
+};
+
+struct GltfAnimation {
+  std::string name;
+  std::vector<GltfChannel> channels;
+};
+
 struct GltfScene {
   std::vector<std::string> nodes;  // JSON objects, e.g. {"name":"a","children":[1]}
   std::vector<int> roots;          // scene root nodes
   std::vector<GltfMesh> meshes;
   std::vector<GltfSkin> skins;
+  std::vector<GltfAnimation> animations;
 
   std::string json() const {
     std::string buffer, views, accessors;
@@ -86,6 +103,34 @@ struct GltfScene {
       if (!skin_json.empty()) skin_json += ",";
       skin_json += "{\"joints\":[" + joints + "],\"inverseBindMatrices\":" + std::to_string(ibm) + "}";
     }
+    std::string animation_json;
+    for (const auto& a : animations) {
+      std::string samplers, channels;
+      for (std::size_t c = 0; c < a.channels.size(); ++c) {
+        const GltfChannel& ch = a.channels[c];
+        float lo = ch.times.front(), hi = ch.times.front();
+        for (float t : ch.times) {
+          lo = std::min(lo, t);
+          hi = std::max(hi, t);
+        }
+        const std::string keys = std::to_string(ch.times.size());
+        const int input = add(ch.times.data(), 4 * ch.times.size(),
+                              "\"componentType\":5126,\"count\":" + keys +
+                                  ",\"type\":\"SCALAR\",\"min\":[" + std::to_string(lo) +
+                                  "],\"max\":[" + std::to_string(hi) + "]");
+        const int output = add(ch.values.data(), 4 * ch.values.size(),
+                               "\"componentType\":5126,\"count\":" + keys + ",\"type\":\"" +
+                                   (ch.path == "rotation" ? "VEC4" : "VEC3") + "\"");
+        samplers += (c == 0 ? "" : ",") + std::string("{\"input\":") + std::to_string(input) +
+                    ",\"output\":" + std::to_string(output) + ",\"interpolation\":\"LINEAR\"}";
+        channels += (c == 0 ? "" : ",") + std::string("{\"sampler\":") + std::to_string(c) +
+                    ",\"target\":{\"node\":" + std::to_string(ch.node) + ",\"path\":\"" +
+                    ch.path + "\"}}";
+      }
+      if (!animation_json.empty()) animation_json += ",";
+      animation_json += "{\"name\":\"" + a.name + "\",\"samplers\":[" + samplers +
+                        "],\"channels\":[" + channels + "]}";
+    }
     for (const auto& n : nodes) node_json += (node_json.empty() ? "" : ",") + n;
     std::string root_json;
     for (int r : roots) root_json += (root_json.empty() ? "" : ",") + std::to_string(r);
@@ -93,6 +138,7 @@ struct GltfScene {
                       root_json + "]}],\"nodes\":[" + node_json + "],\"meshes\":[" + mesh_json +
                       "]";
     if (!skin_json.empty()) out += ",\"skins\":[" + skin_json + "]";
+    if (!animation_json.empty()) out += ",\"animations\":[" + animation_json + "]";
     out += ",\"buffers\":[{\"byteLength\":" + std::to_string(buffer.size()) +
            ",\"uri\":\"data:application/octet-stream;base64," + base64(buffer) +
            "\"}],\"bufferViews\":[" + views + "],\"accessors\":[" + accessors + "]}";

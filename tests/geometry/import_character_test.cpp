@@ -15,6 +15,8 @@ namespace skinlab::geometry {
 namespace {
 namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 
+using skinlab::testing::GltfAnimation;
+using skinlab::testing::GltfChannel;
 using skinlab::testing::GltfMesh;
 using skinlab::testing::GltfScene;
 using skinlab::testing::GltfSkin;
@@ -267,6 +269,30 @@ TEST(ImportCharacter, RigidAttachmentFollowsItsJoint) {
   for (int v = 0; v < 3; ++v) EXPECT_EQ(c.weights.coeff(v, child), 1.0) << v;
   EXPECT_TRUE(row(c.mesh.V, 1).isApprox(Eigen::Vector3d(1, 2, 0), 1e-6));
   EXPECT_EQ(c.weights.coeff(3, c.skeleton.find("root")), 1.0);
+  EXPECT_EQ(report.max_rigid_misplacement, 0.0) << "the nodes are stored in the bind pose";
+}
+
+TEST(ImportCharacter, RigidAttachmentOfAPosedNodeIsMeasured) {
+  // As above, but "child" is stored at y = 3 while the skin binds it at y = 1: the hat stays
+  // where the node hierarchy puts it (y = 4), 2 above where the bind pose would carry it.
+  GltfScene s;
+  s.nodes = {R"({"name":"root","children":[1]})",
+             R"({"name":"child","translation":[0,3,0],"children":[3]})",
+             R"({"name":"body","mesh":0,"skin":0})",
+             R"({"name":"hat","mesh":1,"translation":[0,1,0]})"};
+  s.roots = {0, 2};
+  GltfMesh hat;
+  hat.name = "hat";
+  hat.positions = {{0, 0, 0}, {1, 0, 0}, {0, 0, 1}};
+  hat.indices = {0, 1, 2};
+  s.meshes = {strip("body", 0), hat};
+  s.skins = {GltfSkin{{0, 1}, {translation(0, 0, 0), translation(0, -1, 0)}}};
+  TempDir dir;
+  ImportReport report;
+  const Character c = import_character(dir.write("hat.gltf", s.json()), {}, &report);
+  EXPECT_TRUE(row(c.mesh.V, 0).isApprox(Eigen::Vector3d(0, 4, 0), 1e-6));
+  EXPECT_NEAR(report.max_rigid_misplacement, 2.0, 1e-6);
+  EXPECT_EQ(report.max_rigid_misplacement_joint, "child");
 }
 
 TEST(ImportCharacter, UnweightedVertexOutsideTheSkeletonIsAnError) {
@@ -370,6 +396,237 @@ TEST(ImportCharacter, ColladaNegativeWeightIsDroppedByAssimpAndTheRestRenormalis
   const Character c = import_character(dir.write("negative.dae", collada("1 1.5 -0.5")));
   EXPECT_EQ(c.weights.coeff(3, 0), 1.0);
   EXPECT_EQ(c.weights.coeff(3, 1), 0.0);
+}
+
+/// A bar of 5 rows of 2 vertices (y = 0, 0.5, 1, 1.5, 2; x = 0, 0.2): rows 0–1 on joint 0, row 2
+/// half and half, rows 3–4 on joint 1.
+GltfMesh bar() {
+  GltfMesh m;
+  m.name = "bar";
+  for (int r = 0; r < 5; ++r) {
+    for (int c = 0; c < 2; ++c) {
+      m.positions.emplace_back(0.2f * c, 0.5f * r, 0.0f);
+      m.joints.push_back({0, 1, 0, 0});
+      m.weights.push_back(r < 2 ? std::array<float, 4>{1, 0, 0, 0}
+                          : r == 2 ? std::array<float, 4>{0.5f, 0.5f, 0, 0}
+                                   : std::array<float, 4>{0, 1, 0, 0});
+    }
+  }
+  for (int r = 0; r < 4; ++r) {
+    const auto a = static_cast<std::uint16_t>(2 * r);
+    m.indices.insert(m.indices.end(), {a, static_cast<std::uint16_t>(a + 1),
+                                       static_cast<std::uint16_t>(a + 2),
+                                       static_cast<std::uint16_t>(a + 1),
+                                       static_cast<std::uint16_t>(a + 3),
+                                       static_cast<std::uint16_t>(a + 2)});
+  }
+  return m;
+}
+
+/// The animated bar: "Armature" (node 0: 90° about Z, scale 2) holds the joints root (1) →
+/// child (2, at y = 1) and the skinned mesh node "body" (3). Clips, in file order:
+///   bend:      child turns 0 → 90° about Z and Armature moves 0 → 3 in z, over 1 s;
+///   grow:      child scales 1 → 1.5 over 0.5 s (left out: not rigid);
+///   body_only: only the mesh node moves (left out: animates no joint);
+///   wave:      root turns 0 → 30° → 0 about X over 1 s, child has unit scale keys (kept).
+GltfScene animated_bar() {
+  GltfScene s;
+  s.nodes = {R"({"name":"Armature","children":[1,3],"rotation":[0,0,0.70710678,0.70710678],"scale":[2,2,2]})",
+             R"({"name":"root","children":[2]})", R"({"name":"child","translation":[0,1,0]})",
+             R"({"name":"body","mesh":0,"skin":0})"};
+  s.roots = {0};
+  s.meshes = {bar()};
+  s.skins = {GltfSkin{{1, 2}, {translation(0, 0, 0), translation(0, -1, 0)}}};
+  const float h = static_cast<float>(std::sqrt(0.5));
+  const float x30 = static_cast<float>(std::sin(M_PI / 12)), w30 = static_cast<float>(std::cos(M_PI / 12));
+  s.animations = {
+      GltfAnimation{"bend",
+                    {GltfChannel{2, "rotation", {0, 1}, {0, 0, 0, 1, 0, 0, h, h}},
+                     GltfChannel{0, "translation", {0, 1}, {0, 0, 0, 0, 0, 3}}}},
+      GltfAnimation{"grow", {GltfChannel{2, "scale", {0, 0.5f}, {1, 1, 1, 1.5f, 1.5f, 1.5f}}}},
+      GltfAnimation{"body_only", {GltfChannel{3, "translation", {0, 1}, {0, 0, 0, 5, 0, 0}}}},
+      GltfAnimation{"wave",
+                    {GltfChannel{1, "rotation", {0, 0.5f, 1}, {0, 0, 0, 1, x30, 0, 0, w30, 0, 0, 0, 1}},
+                     GltfChannel{2, "scale", {0, 1}, {1, 1, 1, 1, 1, 1}}}}};
+  return s;
+}
+
+Eigen::Affine3d affine(const Eigen::Matrix3d& linear, const Eigen::Vector3d& t) {
+  Eigen::Affine3d a = Eigen::Affine3d::Identity();
+  a.linear() = linear;
+  a.translation() = t;
+  return a;
+}
+
+/// LBS of the character with frame · bind⁻¹ per joint.
+Eigen::MatrixXd pose(const Character& c, const std::vector<Eigen::Isometry3d>& frame,
+                     const std::vector<Eigen::Isometry3d>& bind) {
+  std::vector<Eigen::Affine3d> T(bind.size());
+  for (std::size_t j = 0; j < T.size(); ++j) T[j] = Eigen::Affine3d((frame[j] * bind[j].inverse()).matrix());
+  return lbs(c.mesh.V, c.weights, T);
+}
+
+TEST(ImportCharacter, BindTransformsPlaceTheJoints) {
+  TempDir dir;
+  ImportedMotion motion;
+  const Character c = import_character(dir.write("bar.gltf", animated_bar().json()), {}, nullptr, &motion);
+  ASSERT_EQ(c.skeleton.names, (std::vector<std::string>{"root", "child"}));
+  EXPECT_EQ(motion.no_bind, "");
+  ASSERT_EQ(motion.bind.size(), 2u);
+  for (int j = 0; j < 2; ++j) {
+    EXPECT_LT((motion.bind[j].translation() - row(c.skeleton.positions, j)).norm(), 1e-9) << j;
+    // The Armature's scale 2 is divided out: what is left is its 90° turn about Z.
+    EXPECT_TRUE(motion.bind[j].linear().isApprox(
+        Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix(), 1e-6));
+  }
+  EXPECT_TRUE(row(c.skeleton.positions, 1).isApprox(Eigen::Vector3d(-2, 0, 0), 1e-6));
+  // Without clip_fps no clip is sampled, but the file's are counted.
+  EXPECT_TRUE(motion.clips.empty());
+  EXPECT_EQ(motion.num_file_clips, 4);
+  EXPECT_TRUE(motion.left_out.empty());
+}
+
+TEST(ImportCharacter, ClipsPoseTheMeshWhereTheKeysPutIt) {
+  TempDir dir;
+  ImportOptions options;
+  options.clip_fps = 24;
+  ImportedMotion motion;
+  const Character c =
+      import_character(dir.write("bar.gltf", animated_bar().json()), options, nullptr, &motion);
+  EXPECT_EQ(motion.num_file_clips, 4);
+  ASSERT_EQ(motion.clips.size(), 2u);
+  EXPECT_EQ(motion.clips[0].name, "bend");
+  EXPECT_EQ(motion.clips[1].name, "wave");
+  EXPECT_EQ(motion.clips[0].fps, 24.0);
+  ASSERT_EQ(motion.clips[0].frames.size(), 25u) << "1 s at 24 fps, both ends included";
+
+  // bend at t = 0, 0.5 and 1 s (frames 0, 12, 24): the Armature A(t) = translate(0, 0, 3t) ·
+  // 2·Rz(90°) carries everything; the child's part also turns by θ(t) = 90°·t about its joint
+  // (mesh-space (0, 1, 0), where the inverse bind matrix puts it). Row 2 blends both halves.
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const GltfMesh mesh = bar();
+  for (int f : {0, 12, 24}) {
+    const double t = f / 24.0;
+    const Eigen::Affine3d A = affine(2 * turn, Eigen::Vector3d(0, 0, 3 * t));
+    const Eigen::Affine3d bend =
+        affine(Eigen::AngleAxisd(M_PI / 2 * t, Eigen::Vector3d::UnitZ()).toRotationMatrix(),
+               Eigen::Vector3d(0, 1, 0)) *
+        affine(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, -1, 0));
+    const Eigen::MatrixXd posed = pose(c, motion.clips[0].frames[f], motion.bind);
+    for (int v = 0; v < 10; ++v) {
+      const Eigen::Vector3d m = mesh.positions[v].cast<double>();
+      const double w_child = mesh.weights[v][1];
+      const Eigen::Vector3d expected = (1 - w_child) * (A * m) + w_child * (A * (bend * m));
+      EXPECT_LT((row(posed, v) - expected).norm(), 1e-5) << "frame " << f << ", vertex " << v
+                                                         << ": " << row(posed, v).transpose();
+    }
+  }
+  // At 90° the tip (mesh (0, 2)) is at mesh (−1, 1), i.e. 2·Rz(90°)·(−1, 1, 0) + (0, 0, 3).
+  EXPECT_TRUE(row(pose(c, motion.clips[0].frames[24], motion.bind), 8)
+                  .isApprox(Eigen::Vector3d(-2, -2, 3), 1e-5));
+
+  // The frames of the first sample of a clip that starts from the stored pose are the bind.
+  for (int j = 0; j < 2; ++j) {
+    EXPECT_TRUE(motion.clips[1].frames[0][j].isApprox(motion.bind[j], 1e-6)) << j;
+  }
+}
+
+TEST(ImportCharacter, RigidlyWeightedVerticesStayRigidInEveryFrame) {
+  TempDir dir;
+  ImportOptions options;
+  options.clip_fps = 30;
+  ImportedMotion motion;
+  const Character c =
+      import_character(dir.write("bar.gltf", animated_bar().json()), options, nullptr, &motion);
+  ASSERT_EQ(motion.clips.size(), 2u);
+  const GltfMesh mesh = bar();
+  double worst = 0, most_moved = 0;
+  for (const ImportedClip& clip : motion.clips) {
+    for (const auto& frame : clip.frames) {
+      ASSERT_EQ(frame.size(), 2u);
+      const Eigen::MatrixXd posed = pose(c, frame, motion.bind);
+      most_moved = std::max(most_moved, (posed - c.mesh.V).rowwise().norm().maxCoeff());
+      for (int u = 0; u < 10; ++u) {
+        for (int v = u + 1; v < 10; ++v) {
+          if (mesh.weights[u][0] == 0.5f || mesh.weights[u] != mesh.weights[v]) continue;
+          const double before = (row(c.mesh.V, u) - row(c.mesh.V, v)).norm();
+          worst = std::max(worst, std::abs((row(posed, u) - row(posed, v)).norm() - before));
+        }
+      }
+    }
+  }
+  std::cout << "bar: largest change of a rigid pair's distance " << worst << ", largest move "
+            << most_moved << "\n";
+  EXPECT_LT(worst, 1e-5);
+  EXPECT_GT(most_moved, 1.0);
+}
+
+TEST(ImportCharacter, ScalingAndJointlessClipsAreLeftOutAndCounted) {
+  TempDir dir;
+  const auto file = dir.write("bar.gltf", animated_bar().json());
+  ImportOptions options;
+  options.clip_fps = 24;
+  ImportedMotion motion;
+  import_character(file, options, nullptr, &motion);
+  EXPECT_EQ(motion.num_scaled_clips, 1);
+  EXPECT_EQ(motion.num_unread_clips, 0);
+  ASSERT_EQ(motion.left_out.size(), 2u);
+  EXPECT_NE(motion.left_out[0].find("'grow': joint 'child' is scaled at frame 1"), std::string::npos)
+      << motion.left_out[0];
+  EXPECT_NE(motion.left_out[1].find("'body_only': no channel animates a joint"), std::string::npos)
+      << motion.left_out[1];
+
+  // max_clips counts kept clips only: grow and body_only are passed over, wave is not read.
+  options.max_clips = 1;
+  import_character(file, options, nullptr, &motion);
+  ASSERT_EQ(motion.clips.size(), 1u);
+  EXPECT_EQ(motion.clips[0].name, "bend");
+  EXPECT_EQ(motion.num_unread_clips, 3);
+  EXPECT_TRUE(motion.left_out.empty());
+
+  options.max_clips = 0;
+  import_character(file, options, nullptr, &motion);
+  EXPECT_TRUE(motion.clips.empty());
+  EXPECT_EQ(motion.num_unread_clips, 4);
+  EXPECT_EQ(motion.bind.size(), 2u) << "the bind does not depend on clips";
+
+  options.max_clips = 8;
+  options.clip_fps = -1;
+  skinlab::testing::expect_error<GeometryError>([&] { import_character(file, options); },
+                                                {"bar.gltf", "clip_fps"});
+}
+
+TEST(ImportCharacter, NonUniformBindScaleLeavesNoBind) {
+  // The Armature scales x only: joint transforms are no longer rotations times one scale, and
+  // frame · bind⁻¹ could not be written rigidly; the character itself still imports.
+  GltfScene s = animated_bar();
+  s.nodes[0] = R"({"name":"Armature","children":[1,3],"scale":[1,2,1]})";
+  TempDir dir;
+  ImportOptions options;
+  options.clip_fps = 24;
+  ImportedMotion motion;
+  const Character c = import_character(dir.write("stretched.gltf", s.json()), options, nullptr, &motion);
+  EXPECT_EQ(c.skeleton.num_joints(), 2);
+  EXPECT_TRUE(motion.bind.empty());
+  EXPECT_TRUE(motion.clips.empty());
+  EXPECT_NE(motion.no_bind.find("joint 'root'"), std::string::npos) << motion.no_bind;
+  EXPECT_NE(motion.no_bind.find("uniform positive scale"), std::string::npos) << motion.no_bind;
+}
+
+TEST(ImportCharacter, MeshesBindingAJointDifferentlyLeaveNoBind) {
+  // Two meshes share the skin, but the second's node is moved by 1 in x: B(bone) = G(mesh) ·
+  // inverse(IBM) differs between them, and one bind per joint cannot pose both.
+  GltfScene s;
+  s.nodes = {R"({"name":"root","children":[1]})", R"({"name":"child","translation":[0,1,0]})",
+             R"({"name":"a","mesh":0,"skin":0})", R"({"name":"b","mesh":1,"skin":0,"translation":[1,0,0]})"};
+  s.roots = {0, 2, 3};
+  s.meshes = {strip("a", 0), strip("b", 3)};
+  s.skins = {GltfSkin{{0, 1}, {translation(0, 0, 0), translation(0, -1, 0)}}};
+  TempDir dir;
+  ImportedMotion motion;
+  import_character(dir.write("two.gltf", s.json()), {}, nullptr, &motion);
+  EXPECT_TRUE(motion.bind.empty());
+  EXPECT_NE(motion.no_bind.find("meshes bind joint"), std::string::npos) << motion.no_bind;
 }
 
 TEST(ImportCharacter, NoBonesIsAnError) {
