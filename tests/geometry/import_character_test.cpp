@@ -242,11 +242,12 @@ TEST(ImportCharacter, GltfTwoSkinnedMeshesMergeByJointName) {
   EXPECT_NEAR(c.weights.coeff(7, child), 0.75, 1e-7);
 }
 
-TEST(ImportCharacter, RigidAttachmentFollowsItsJoint) {
-  // "hat" is an unskinned mesh below the joint node "child" (offset by +1 in y from it).
+/// "hat" is an unskinned mesh below the joint node "child" (offset by +1 in y from it); the node
+/// "child" is stored at y = `child_y`, the skin binds it at y = 1.
+GltfScene hat_scene(double child_y) {
   GltfScene s;
   s.nodes = {R"({"name":"root","children":[1]})",
-             R"({"name":"child","translation":[0,1,0],"children":[3]})",
+             R"({"name":"child","translation":[0,)" + std::to_string(child_y) + R"(,0],"children":[3]})",
              R"({"name":"body","mesh":0,"skin":0})",
              R"({"name":"hat","mesh":1,"translation":[0,1,0]})"};
   s.roots = {0, 2};
@@ -256,6 +257,11 @@ TEST(ImportCharacter, RigidAttachmentFollowsItsJoint) {
   hat.indices = {0, 1, 2};
   s.meshes = {strip("body", 0), hat};
   s.skins = {GltfSkin{{0, 1}, {translation(0, 0, 0), translation(0, -1, 0)}}};
+  return s;
+}
+
+TEST(ImportCharacter, RigidAttachmentFollowsItsJoint) {
+  const GltfScene s = hat_scene(1);
   TempDir dir;
   ImportReport report;
   const Character c = import_character(dir.write("hat.gltf", s.json()), {}, &report);
@@ -273,20 +279,9 @@ TEST(ImportCharacter, RigidAttachmentFollowsItsJoint) {
 }
 
 TEST(ImportCharacter, RigidAttachmentOfAPosedNodeIsMeasured) {
-  // As above, but "child" is stored at y = 3 while the skin binds it at y = 1: the hat stays
-  // where the node hierarchy puts it (y = 4), 2 above where the bind pose would carry it.
-  GltfScene s;
-  s.nodes = {R"({"name":"root","children":[1]})",
-             R"({"name":"child","translation":[0,3,0],"children":[3]})",
-             R"({"name":"body","mesh":0,"skin":0})",
-             R"({"name":"hat","mesh":1,"translation":[0,1,0]})"};
-  s.roots = {0, 2};
-  GltfMesh hat;
-  hat.name = "hat";
-  hat.positions = {{0, 0, 0}, {1, 0, 0}, {0, 0, 1}};
-  hat.indices = {0, 1, 2};
-  s.meshes = {strip("body", 0), hat};
-  s.skins = {GltfSkin{{0, 1}, {translation(0, 0, 0), translation(0, -1, 0)}}};
+  // "child" stored at y = 3 while the skin binds it at y = 1: the hat stays where the node
+  // hierarchy puts it (y = 4), 2 above where the bind pose would carry it.
+  const GltfScene s = hat_scene(3);
   TempDir dir;
   ImportReport report;
   const Character c = import_character(dir.write("hat.gltf", s.json()), {}, &report);
