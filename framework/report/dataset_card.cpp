@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <map>
 #include <set>
 
@@ -136,6 +137,46 @@ std::string dataset_card_markdown(const data::Dataset& d, const fs::path& datase
         "`framework/data/augment.hpp`): re-posed, scaled or mirrored characters named "
         "`<original>~aug<i>`, only in train parts. They are left out of every table below.",
         copies));
+    line();
+  }
+
+  // ---- motion: what the corrective and sequence tasks can use. Per source: with bind pose,
+  // with clips, with ≥ 4 clips of ≥ 8 frames, clips, frames.
+  std::map<std::string, std::array<int, 5>> motion;
+  std::array<int, 5> total{};
+  for (const auto& [src, list] : by_source) {
+    std::array<int, 5>& row = motion[src];
+    row.fill(0);
+    for (int i : list) {
+      const data::PreparedCharacter& c = d.characters[static_cast<std::size_t>(i)];
+      int long_clips = 0;
+      for (const auto& a : c.animations) {
+        long_clips += a.num_frames >= 8;
+        row[4] += a.num_frames;
+      }
+      row[0] += !c.bind.empty();
+      row[1] += !c.animations.empty();
+      row[2] += long_clips >= 4;
+      row[3] += static_cast<int>(c.animations.size());
+    }
+    for (std::size_t k = 0; k < row.size(); ++k) total[k] += row[k];
+  }
+  if (total[0] > 0 || total[1] > 0) {
+    line("## Bind poses and clips");
+    line();
+    line("Per source: characters with their bind pose in the file (`bind`, so that their skeleton "
+         "family's clips can pose them), with clips of their own, with at least 4 clips of at "
+         "least 8 frames (the mesh-sequence task's default `min_frames`), and the clips and "
+         "frames in all.");
+    line();
+    line("| source | with bind pose | with clips | with ≥ 4 clips of ≥ 8 frames | clips | frames |");
+    line("|---|---:|---:|---:|---:|---:|");
+    for (const auto& [src, row] : motion) {
+      line(fmt::format("| {} | {} | {} | {} | {} | {} |", src, row[0], row[1], row[2], row[3],
+                       row[4]));
+    }
+    line(fmt::format("| **all** | **{}** | **{}** | **{}** | **{}** | **{}** |", total[0],
+                     total[1], total[2], total[3], total[4]));
     line();
   }
 

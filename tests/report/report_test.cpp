@@ -120,6 +120,15 @@ TEST(DatasetCard, ReportsCountsSplitsExclusionsAndLicencesWithoutAugmentedCopies
   d.characters[2].source = "other";
   d.characters[2].skeleton = "bird";
   d.characters[2].licence = "GPL-2+";
+  // b: four clips of 8 frames besides its own 2-frame one; c: no bind pose.
+  for (int k = 0; k < 4; ++k) {
+    data::AnimationData clip = d.characters[1].animations.front();
+    clip.name = "long" + std::to_string(k);
+    clip.num_frames = 8;
+    clip.frames.assign(static_cast<std::size_t>(8 * 3 * 12), 0.5f);
+    d.characters[1].animations.push_back(clip);
+  }
+  d.characters[2].bind.clear();
   // An augmented training copy of a (data/augment.hpp): in no table, counted once.
   d.characters.push_back(testing::tiny_character("a~aug0"));
   d.characters[3].augmented_from = "a";
@@ -136,7 +145,10 @@ TEST(DatasetCard, ReportsCountsSplitsExclusionsAndLicencesWithoutAugmentedCopies
         "| test | 2 | 1 | 1 | 1 |", "| **all** | **3** | **2** | **2** | **1** |",
         "| random | 0 / 0 / 1 | 2 / 0 / 0 | 2 / 0 / 1 |" /* other, test, all: train/val/test */,
         "rigid-only weights \\| one joint", "| other | GPL-2+ | 1 | skinlab tests |",
-        "| 2 | c | other | bird | c | 5 → 4 |", "![", "card/bones.png"}) {
+        "| 2 | c | other | bird | c | 5 → 4 |", "![", "card/bones.png",
+        // bind poses and clips: with bind, with clips, with ≥ 4 of ≥ 8 frames, clips, frames
+        "## Bind poses and clips", "| other | 0 | 1 | 0 | 1 | 2 |", "| test | 2 | 2 | 1 | 6 | 36 |",
+        "| **all** | **2** | **3** | **1** | **7** | **38** |"}) {
     EXPECT_NE(md.find(part), std::string::npos) << part << "\n" << md;
   }
   EXPECT_NE(md.find("also holds 1 augmented copies"), std::string::npos) << md;
