@@ -60,8 +60,10 @@ namespace skinlab::bdlstm {
 ///       frame_stride: 1       # every k-th frame (Sec. 4: every other model for slow motion)
 ///       min_frames: 8         # clips with fewer sampled frames are left out, with the reason
 ///       test_fraction: 0.2    # the held-out subsequence of each sequence (Sec. 4.1)
-///       val_fraction: 0.1     # a validation window beside it (best.pt, early stopping); 0: none,
-///                             # the paper's split (val_fraction + test_fraction < 1)
+///       val_fraction: 0       # a validation window beside it (best.pt, early stopping); 0: none,
+///                             # the paper's split (val_fraction + test_fraction < 1). 0 by
+///                             # default, so a run saved before the key existed resumes with
+///                             # its own split; configs/bdlstm/task.yaml sets 0.1
 ///       seed: 0               # draws the held-out windows
 ///       folder: ""            # a folder of OBJ sequences instead of the dataset file (below)
 ///       up: [0, 1, 0]         # a folder's up axis (its meshes are turned to Y up)
@@ -72,7 +74,7 @@ struct SequenceOptions {
   int frame_stride = 1;
   int min_frames = 8;
   double test_fraction = 0.2;
-  double val_fraction = 0.1;
+  double val_fraction = 0;
   std::uint64_t seed = 0;
   /// Decodes and checks the section (every field optional); errors name the file, line, key.
   /// `other_keys` are accepted and left to the caller (the task's own keys, sequence_task.hpp).
