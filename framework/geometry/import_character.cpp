@@ -192,9 +192,9 @@ NodeChain node_chain(const aiNode* root, const std::vector<const aiNode*>& joint
   return chain;
 }
 
-/// Samples clip `a` (index k in the file) into `clip`; returns "" or why it is left out.
-/// `scaled` is set when the reason is a joint's scale.
-std::string sample_clip(const aiAnimation& a, unsigned k, const NodeChain& chain,
+/// Samples clip `a` into `clip` (named `clip.name` by the caller); returns "" or why it is left
+/// out. `scaled` is set when the reason is a joint's scale.
+std::string sample_clip(const aiAnimation& a, const NodeChain& chain,
                         const std::vector<std::string>& joint_names,
                         const std::vector<double>& bind_scale, const ImportOptions& options,
                         ImportedClip& clip, bool& scaled) {
@@ -250,7 +250,6 @@ std::string sample_clip(const aiAnimation& a, unsigned k, const NodeChain& chain
     rest[i] = {Eigen::Vector3d(p.x, p.y, p.z), Eigen::Vector3d(s.x, s.y, s.z), to_quaternion(q)};
   }
 
-  clip.name = a.mName.length > 0 ? a.mName.C_Str() : "clip" + std::to_string(k);
   clip.fps = options.clip_fps;
   clip.frames.assign(static_cast<std::size_t>(num_frames), {});
   std::vector<Eigen::Matrix4d> global(chain.nodes.size());
@@ -399,9 +398,9 @@ Character import_character(const std::filesystem::path& file, const ImportOption
   Skeleton skeleton;
   std::unordered_map<const aiNode*, int> joint_of;
   std::set<std::string> used_names;
-  std::vector<Eigen::Vector3d> positions;
   std::vector<const aiNode*> joint_nodes;
-  std::vector<Eigen::Matrix4d> joint_bind;  // B(bone), or G(node) for a joint that is no bone
+  // B(bone), or G(node) for a joint that is no bone: its translation is the joint's position.
+  std::vector<Eigen::Matrix4d> joint_bind;
   std::function<void(const aiNode*, int)> visit = [&](const aiNode* node, int parent) {
     if (keep.count(node) == 0) return;
     std::string name = node->mName.C_Str();
@@ -415,16 +414,14 @@ Character import_character(const std::filesystem::path& file, const ImportOption
     skeleton.names.push_back(name);
     skeleton.parents.push_back(parent);
     const auto b = bind.find(node);
-    const Eigen::Matrix4d g = b != bind.end() ? b->second : global_transform(node);
-    positions.push_back(g.block<3, 1>(0, 3));
     joint_nodes.push_back(node);
-    joint_bind.push_back(g);
+    joint_bind.push_back(b != bind.end() ? b->second : global_transform(node));
     for (unsigned c = 0; c < node->mNumChildren; ++c) visit(node->mChildren[c], j);
   };
   visit(lca, -1);
-  skeleton.positions.resize(static_cast<Eigen::Index>(positions.size()), 3);
-  for (std::size_t j = 0; j < positions.size(); ++j) {
-    skeleton.positions.row(static_cast<Eigen::Index>(j)) = positions[j].transpose();
+  skeleton.positions.resize(static_cast<Eigen::Index>(joint_bind.size()), 3);
+  for (std::size_t j = 0; j < joint_bind.size(); ++j) {
+    skeleton.positions.row(static_cast<Eigen::Index>(j)) = joint_bind[j].block<3, 1>(0, 3).transpose();
   }
 
   // Mesh and weights, instance by instance.
@@ -574,15 +571,14 @@ Character import_character(const std::filesystem::path& file, const ImportOption
         const aiAnimation* a = scene->mAnimations[k];
         if (a == nullptr) continue;
         ImportedClip clip;
+        clip.name = a->mName.length > 0 ? std::string(a->mName.C_Str()) : "clip" + std::to_string(k);
         bool scaled = false;
-        const std::string why = sample_clip(*a, k, chain, names, bind_scale, options, clip, scaled);
+        const std::string why = sample_clip(*a, chain, names, bind_scale, options, clip, scaled);
         if (why.empty()) {
           motion->clips.push_back(std::move(clip));
         } else {
           motion->num_scaled_clips += scaled;
-          motion->left_out.push_back(
-              "'" + (a->mName.length > 0 ? std::string(a->mName.C_Str()) : "clip" + std::to_string(k)) +
-              "': " + why);
+          motion->left_out.push_back("'" + clip.name + "': " + why);
         }
       }
     }
