@@ -65,10 +65,20 @@ std::pair<int, int> held_out_window(int frames, double fraction, std::uint64_t s
   return {begin, begin + length};
 }
 
+namespace {
+
+/// The validation window's length in a sequence of `frames` frames: round(fraction · frames),
+/// at least 1 (fraction > 0).
+int validation_length(int frames, double fraction) {
+  return std::max(1, static_cast<int>(std::lround(fraction * frames)));
+}
+
+}  // namespace
+
 std::optional<std::pair<int, int>> validation_window(int frames, std::pair<int, int> test,
                                                      double fraction) {
   if (fraction <= 0) return std::pair{0, 0};
-  const int length = std::max(1, static_cast<int>(std::lround(fraction * frames)));
+  const int length = validation_length(frames, fraction);
   if ((test.second - test.first) + length > frames - 1) return std::nullopt;
   if (test.first >= length) return std::pair{test.first - length, test.first};
   if (test.second + length <= frames) return std::pair{test.second, test.second + length};
@@ -267,7 +277,7 @@ void SequenceData::add_sequence(SequenceCharacter& out, MeshSequence s) {
         "{}/{}: {} sampled frames, no room for a validation window of {} frame(s) (val_fraction = "
         "{}) beside its test window {}..{} (test_fraction = {}) with a training frame left",
         out.name, s.clip, s.num_frames(),
-        std::max(1, static_cast<int>(std::lround(options_.val_fraction * s.num_frames()))),
+        validation_length(s.num_frames(), options_.val_fraction),
         options_.val_fraction, test.first, test.second - 1, options_.test_fraction));
     return;
   }
