@@ -461,10 +461,17 @@ Eigen::MatrixXd pose(const Character& c, const std::vector<Eigen::Isometry3d>& f
   return lbs(c.mesh.V, c.weights, T);
 }
 
-TEST(ImportCharacter, BindTransformsPlaceTheJoints) {
+/// The animated bar imported with its motion, its clips sampled at `clip_fps` (0: none).
+Character import_animated_bar(double clip_fps, ImportedMotion& motion) {
   TempDir dir;
+  ImportOptions options;
+  options.clip_fps = clip_fps;
+  return import_character(dir.write("bar.gltf", animated_bar().json()), options, nullptr, &motion);
+}
+
+TEST(ImportCharacter, BindTransformsPlaceTheJoints) {
   ImportedMotion motion;
-  const Character c = import_character(dir.write("bar.gltf", animated_bar().json()), {}, nullptr, &motion);
+  const Character c = import_animated_bar(0, motion);
   ASSERT_EQ(c.skeleton.names, (std::vector<std::string>{"root", "child"}));
   EXPECT_EQ(motion.no_bind, "");
   ASSERT_EQ(motion.bind.size(), 2u);
@@ -482,12 +489,8 @@ TEST(ImportCharacter, BindTransformsPlaceTheJoints) {
 }
 
 TEST(ImportCharacter, ClipsPoseTheMeshWhereTheKeysPutIt) {
-  TempDir dir;
-  ImportOptions options;
-  options.clip_fps = 24;
   ImportedMotion motion;
-  const Character c =
-      import_character(dir.write("bar.gltf", animated_bar().json()), options, nullptr, &motion);
+  const Character c = import_animated_bar(24, motion);
   EXPECT_EQ(motion.num_file_clips, 4);
   ASSERT_EQ(motion.clips.size(), 2u);
   EXPECT_EQ(motion.clips[0].name, "bend");
@@ -527,12 +530,8 @@ TEST(ImportCharacter, ClipsPoseTheMeshWhereTheKeysPutIt) {
 }
 
 TEST(ImportCharacter, RigidlyWeightedVerticesStayRigidInEveryFrame) {
-  TempDir dir;
-  ImportOptions options;
-  options.clip_fps = 30;
   ImportedMotion motion;
-  const Character c =
-      import_character(dir.write("bar.gltf", animated_bar().json()), options, nullptr, &motion);
+  const Character c = import_animated_bar(30, motion);
   ASSERT_EQ(motion.clips.size(), 2u);
   const GltfMesh mesh = bar();
   double worst = 0, most_moved = 0;
