@@ -1,6 +1,7 @@
 #include "experiments/bdlstm/sequence_table.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <cmath>
 #include <map>
@@ -8,6 +9,7 @@
 #include <set>
 
 #include "framework/core/error.hpp"
+#include "framework/eval/paired_t.hpp"
 
 namespace skinlab::bdlstm {
 
@@ -34,6 +36,109 @@ std::string ordinal(int n) {
 
 void add_unique(std::vector<std::string>& list, const std::string& value) {
   if (std::find(list.begin(), list.end(), value) == list.end()) list.push_back(value);
+}
+
+std::string cell_text(const Row& r, const std::string& ch, int h, int decimals, const char* missing) {
+  const auto it = r.cells.find({ch, h});
+  return it == r.cells.end() ? std::string(missing) : fmt::format("{:.{}f}", it->second, decimals);
+}
+
+/// The characters of `r` at horizon `h`, in `characters`' order, and its values there.
+std::vector<std::pair<std::string, double>> column(const Row& r, const std::vector<std::string>& characters,
+                                                   int h) {
+  std::vector<std::pair<std::string, double>> out;
+  for (const auto& ch : characters) {
+    const auto it = r.cells.find({ch, h});
+    if (it != r.cells.end()) out.emplace_back(ch, it->second);
+  }
+  return out;
+}
+
+/// Qiao et al.'s Table 1 layout for one character: one column per horizon.
+std::string single_character_layout(const std::vector<Row>& rows, const Row& starts,
+                                    const std::string& character, const std::set<int>& horizons) {
+  std::string out = "| method |", rule = "|---|";
+  for (int h : horizons) {
+    out += fmt::format(" {} {} |", character, ordinal(h));
+    rule += "---:|";
+  }
+  out += "\n" + rule + "\n";
+  for (const Row& r : rows) {
+    out += "| " + r.label + " |";
+    for (int h : horizons) out += " " + cell_text(r, character, h, 2, "—") + " |";
+    out += "\n";
+  }
+  out += "\nMean vertex error in mm (characters scaled to 1 m). Predictions per cell:";
+  for (int h : horizons) {
+    out += fmt::format(" {} {}: {};", character, ordinal(h), cell_text(starts, character, h, 0, "—"));
+  }
+  out.back() = '.';
+  return out + "\n";
+}
+
+/// Tables 1-2 over several characters (the paper trains one network per mesh, Sec. 3.2): one
+/// row per method, per horizon the mean over the characters that reach it and the two-sided
+/// paired t-test over those characters against the first row (eval/paired_t.hpp).
+std::string mean_layout(const std::vector<Row>& rows, const Row& starts,
+                        const std::vector<std::string>& characters, const std::set<int>& horizons) {
+  std::string out = "| method |", rule = "|---|";
+  for (int h : horizons) {
+    out += fmt::format(" {} | p |", ordinal(h));
+    rule += "---:|---:|";
+  }
+  out += "\n" + rule + "\n";
+  const Row& reference = rows.front();
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const Row& r = rows[i];
+    const bool floor = i + 1 == rows.size();  // the representation's floor: not a method
+    out += "| " + r.label + " |";
+    for (int h : horizons) {
+      const auto values = column(r, characters, h);
+      const std::size_t reached = column(starts, characters, h).size();
+      if (values.empty()) {
+        out += " — | |";
+        continue;
+      }
+      double sum = 0;
+      for (const auto& v : values) sum += v.second;
+      out += fmt::format(" {:.2f}", sum / static_cast<double>(values.size()));
+      if (values.size() < reached) out += fmt::format(" ({} of {})", values.size(), reached);
+      out += " |";
+      if (i == 0 || floor) {
+        out += " |";
+        continue;
+      }
+      // Paired over the characters both rows report at this horizon.
+      std::vector<double> a, b;
+      for (const auto& [ch, v] : values) {
+        const auto it = reference.cells.find({ch, h});
+        if (it == reference.cells.end()) continue;
+        a.push_back(it->second);
+        b.push_back(v);
+      }
+      if (a.size() < 2) {
+        out += " |";
+        continue;
+      }
+      const eval::PairedT t = eval::paired_t_test(a, b);
+      out += std::isnan(t.p) ? std::string(" |") : fmt::format(" {:.2g} |", t.p);
+    }
+    out += "\n";
+  }
+  out += fmt::format("\nMean over characters of each character's mean vertex error in mm (characters "
+                     "scaled to 1 m); p: two-sided paired t-test over the same characters against "
+                     "{}. Characters reaching each horizon (predictions):",
+                     reference.label);
+  for (int h : horizons) {
+    double predictions = 0;
+    const auto reached = column(starts, characters, h);
+    for (const auto& v : reached) predictions += v.second;
+    out += fmt::format(" {}: {} ({:.0f});", ordinal(h), reached.size(), predictions);
+  }
+  out.back() = '.';
+  out += "\nCharacters: " + fmt::format("{}", fmt::join(characters, ", ")) +
+         ". Per character: the CSV beside this table.\n";
+  return out;
 }
 
 }  // namespace
@@ -83,36 +188,14 @@ std::string sequence_table(const std::vector<report::RunResult>& runs,
     if (!any) throw Error("sequence table: " + run.dir.string() + " reports no e<h>_<u>if_mm value");
   }
   rows.push_back(floor);
-  const bool md = options.format == "md";
-  const auto cell = [&](const Row& r, const std::string& ch, int h, int decimals) {
-    const auto it = r.cells.find({ch, h});
-    return it == r.cells.end() ? std::string(md ? "—" : "") : fmt::format("{:.{}f}", it->second, decimals);
-  };
   std::string out;
-  if (md) {
+  if (options.format == "md") {
     if (!options.title.empty()) out += "### " + options.title + "\n\n";
-    out += "| method |";
-    std::string rule = "|---|";
-    for (const auto& ch : characters) {
-      for (int h : horizons) {
-        out += fmt::format(" {} {} |", ch, ordinal(h));
-        rule += "---:|";
-      }
+    if (characters.size() > 1) {
+      out += mean_layout(rows, starts, characters, horizons);
+    } else {
+      out += single_character_layout(rows, starts, characters.front(), horizons);
     }
-    out += "\n" + rule + "\n";
-    for (const Row& r : rows) {
-      out += "| " + r.label + " |";
-      for (const auto& ch : characters) {
-        for (int h : horizons) out += " " + cell(r, ch, h, 2) + " |";
-      }
-      out += "\n";
-    }
-    out += "\nMean vertex error in mm (characters scaled to 1 m). Predictions per cell:";
-    for (const auto& ch : characters) {
-      for (int h : horizons) out += fmt::format(" {} {}: {};", ch, ordinal(h), cell(starts, ch, h, 0));
-    }
-    out.back() = '.';
-    out += "\n";
     if (!runs.front().metric_definitions.empty()) out += "\n" + runs.front().metric_definitions + ".\n";
     if (!options.command.empty()) out += "\nGenerated by `" + options.command + "`.\n";
   } else {
@@ -121,7 +204,8 @@ std::string sequence_table(const std::vector<report::RunResult>& runs,
       for (const auto& ch : characters) {
         for (int h : horizons) {
           if (r.cells.count({ch, h})) {
-            out += fmt::format("\"{}\",{},{},{},{}\n", r.label, ch, h, cell(r, ch, h, 6), cell(starts, ch, h, 0));
+            out += fmt::format("\"{}\",{},{},{},{}\n", r.label, ch, h, cell_text(r, ch, h, 6, ""),
+                               cell_text(starts, ch, h, 0, ""));
           }
         }
       }

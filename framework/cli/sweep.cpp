@@ -14,9 +14,14 @@
 ///       - configs/heterskinnet.yaml
 ///       - {config: configs/ablations/euclidean.yaml, overrides: [seed=1], run_id: table4-seed1}
 ///       - {run: results/heterskinnet/full-20261123}   # an existing run: evaluated if needed
+///     each:                             # optional: every `config:` entry once per value
+///       override: "sequences.characters=[{}]"   # {} is the value; after the sweep's overrides
+///       values: [wolf, mastiff]
 ///
-/// An entry's run id is the sweep's name unless it sets `run_id`; two entries that would share a
-/// run directory (same experiment and run id) are an error.
+/// An entry's run id is the sweep's name unless it sets `run_id`; with `each`, "-<value>" is
+/// appended (table4-seed1-wolf). This is how one network per character (the mesh-sequence task,
+/// Qiao et al. Sec. 3.2) or one run per seed is swept from one file. Two entries that would
+/// share a run directory (same experiment and run id) are an error.
 ///
 /// A sweep can be interrupted and run again: an entry whose run directory exists continues
 /// (training resumes from last.pt; a finished run is only re-evaluated if its evaluation is
@@ -65,7 +70,39 @@ struct Sweep {
   std::vector<std::string> overrides;
   std::vector<std::string> metrics = report::TableOptions{}.metrics;
   bool predictions = false;
-  std::vector<Entry> runs;
+  std::vector<Entry> runs;  ///< after `each` is expanded
+
+  /// `each`: every `config:` entry once per value, `override` with {} replaced by the value.
+  static std::vector<Entry> expand(const std::string& name, std::vector<Entry> entries,
+                                   const config::Node& each) {
+    std::string override_pattern;
+    std::vector<std::string> values;
+    config::Fields e(each, "the sweep's `each`", {});
+    e.required("override", override_pattern)
+        .check(override_pattern.find("{}") != std::string::npos, "override",
+               "must contain {} (where each value goes)");
+    e.required("values", values).check(!values.empty(), "values", "must not be empty");
+    for (const std::string& v : values) {
+      e.check(!v.empty() && v.find_first_of("/\\ \t") == std::string::npos, "values",
+              "'" + v + "' cannot be part of a run directory's name");
+    }
+    e.finish();
+    std::vector<Entry> out;
+    for (const Entry& entry : entries) {
+      if (!entry.run.empty()) {
+        each.fail("applies to `config:` entries; '" + entry.run + "' is an existing run");
+      }
+      for (const std::string& v : values) {
+        Entry x = entry;
+        std::string o = override_pattern;
+        o.replace(o.find("{}"), 2, v);
+        x.overrides.insert(x.overrides.begin(), o);
+        x.run_id = (entry.run_id.empty() ? name : entry.run_id) + "-" + v;
+        out.push_back(std::move(x));
+      }
+    }
+    return out;
+  }
 
   static Sweep from(const config::Config& file) {
     Sweep s;
@@ -78,6 +115,7 @@ struct Sweep {
     f.optional("metrics", s.metrics);
     f.optional("predictions", s.predictions);
     const config::Node runs = f.section("runs");
+    const config::Node each = f.section("each");
     f.finish();
     if (!runs.is_sequence() || runs.size() == 0) runs.fail("expected a non-empty list of runs");
     for (std::size_t i = 0; i < runs.size(); ++i) {
@@ -98,6 +136,7 @@ struct Sweep {
       }
       s.runs.push_back(std::move(e));
     }
+    if (each.exists()) s.runs = expand(s.name, std::move(s.runs), each);
     return s;
   }
 };

@@ -380,6 +380,26 @@ TEST(Cli, SmokeRunPrepareTrainEvalOnTheBundledSubset) {
   const Result t2 = run("sweep " + twice.string());
   EXPECT_EQ(t2.status, 1);
   EXPECT_NE(t2.err.find("would share the run directory"), std::string::npos) << t2.err;
+  // `each` runs every entry once per value, under the run id "<name>-<value>".
+  const auto each = dir.write(
+      "each.yaml", "name: ea\nout: " + (dir / "tables" / "ea.md").string() +
+                       "\noverrides: [data.file=" + data + ", results_dir=" + results +
+                       ", train.epochs=1]\neach: {override: 'seed={}', values: [3, 4]}\n"
+                       "runs: [configs/smoke.yaml]\n");
+  const Result ea = run("sweep " + each.string());
+  ASSERT_EQ(ea.status, 0) << ea.err;
+  const std::string each_table = read_file(dir / "tables" / "ea.md");
+  EXPECT_TRUE(has_row(each_table, "smoke", "ea-3")) << each_table;
+  EXPECT_TRUE(has_row(each_table, "smoke", "ea-4")) << each_table;
+  EXPECT_NE(read_file(std::filesystem::path(results) / "smoke" / "ea-4" / "config.yaml")
+                .find("seed: 4\n"),
+            std::string::npos);
+  const auto bad_each = dir.write(
+      "bad_each.yaml", "name: b\nout: x.md\neach: {override: 'seed=1', values: [3]}\n"
+                       "runs: [configs/smoke.yaml]\n");
+  const Result be = run("sweep " + bad_each.string());
+  EXPECT_EQ(be.status, 1);
+  EXPECT_NE(be.err.find("must contain {}"), std::string::npos) << be.err;
 
   check_smoke_table3(dir, data, results);
 }
