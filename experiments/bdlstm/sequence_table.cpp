@@ -87,6 +87,8 @@ std::string mean_layout(const std::vector<Row>& rows, const Row& starts,
     rule += "---:|---:|";
   }
   out += "\n" + rule + "\n";
+  std::map<int, std::vector<std::pair<std::string, double>>> reached;  // horizon → predictions
+  for (int h : horizons) reached[h] = column(starts, characters, h);
   const Row& reference = rows.front();
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const Row& r = rows[i];
@@ -94,7 +96,6 @@ std::string mean_layout(const std::vector<Row>& rows, const Row& starts,
     out += "| " + r.label + " |";
     for (int h : horizons) {
       const auto values = column(r, characters, h);
-      const std::size_t reached = column(starts, characters, h).size();
       if (values.empty()) {
         out += " — | |";
         continue;
@@ -102,7 +103,9 @@ std::string mean_layout(const std::vector<Row>& rows, const Row& starts,
       double sum = 0;
       for (const auto& v : values) sum += v.second;
       out += fmt::format(" {:.2f}", sum / static_cast<double>(values.size()));
-      if (values.size() < reached) out += fmt::format(" ({} of {})", values.size(), reached);
+      if (values.size() < reached[h].size()) {
+        out += fmt::format(" ({} of {})", values.size(), reached[h].size());
+      }
       out += " |";
       if (i == 0 || floor) {
         out += " |";
@@ -129,11 +132,10 @@ std::string mean_layout(const std::vector<Row>& rows, const Row& starts,
                      "scaled to 1 m); p: two-sided paired t-test over the same characters against "
                      "{}. Characters reaching each horizon (predictions):",
                      reference.label);
-  for (int h : horizons) {
-    double predictions = 0;
-    const auto reached = column(starts, characters, h);
-    for (const auto& v : reached) predictions += v.second;
-    out += fmt::format(" {}: {} ({:.0f});", ordinal(h), reached.size(), predictions);
+  for (const auto& [h, predictions] : reached) {
+    double sum = 0;
+    for (const auto& v : predictions) sum += v.second;
+    out += fmt::format(" {}: {} ({:.0f});", ordinal(h), predictions.size(), sum);
   }
   out.back() = '.';
   out += "\nCharacters: " + fmt::format("{}", fmt::join(characters, ", ")) +

@@ -351,11 +351,17 @@ TEST(Cli, SmokeRunPrepareTrainEvalOnTheBundledSubset) {
 
   // A sweep of two entries (two seeds) trains, evaluates and tabulates both; run again, it only
   // re-reads the finished runs; a changed config under the same run directory is an error.
-  const auto sweep = dir.write(
-      "sweep.yaml", "name: sw\nout: " + (dir / "tables" / "sw.md").string() +
-                        "\noverrides: [data.file=" + data + ", results_dir=" + results +
-                        ", train.epochs=1]\nruns:\n  - configs/smoke.yaml\n"
-                        "  - {config: configs/smoke.yaml, overrides: [seed=1], run_id: sw-seed1}\n");
+  // A sweep `name` of one-epoch smoke runs on the bundled subset, its table in tables/<name>.md;
+  // `body` holds its runs (and `each`).
+  const auto smoke_sweep = [&](const std::string& name, const std::string& body) {
+    return dir.write(name + ".yaml", "name: " + name + "\nout: " +
+                                         (dir / "tables" / (name + ".md")).string() +
+                                         "\noverrides: [data.file=" + data + ", results_dir=" +
+                                         results + ", train.epochs=1]\n" + body);
+  };
+  const auto sweep = smoke_sweep(
+      "sw", "runs:\n  - configs/smoke.yaml\n"
+            "  - {config: configs/smoke.yaml, overrides: [seed=1], run_id: sw-seed1}\n");
   const Result s1 = run("sweep " + sweep.string());
   ASSERT_EQ(s1.status, 0) << s1.err;
   const std::string table = read_file(dir / "tables" / "sw.md");
@@ -381,11 +387,8 @@ TEST(Cli, SmokeRunPrepareTrainEvalOnTheBundledSubset) {
   EXPECT_EQ(t2.status, 1);
   EXPECT_NE(t2.err.find("would share the run directory"), std::string::npos) << t2.err;
   // `each` runs every entry once per value, under the run id "<name>-<value>".
-  const auto each = dir.write(
-      "each.yaml", "name: ea\nout: " + (dir / "tables" / "ea.md").string() +
-                       "\noverrides: [data.file=" + data + ", results_dir=" + results +
-                       ", train.epochs=1]\neach: {override: 'seed={}', values: [3, 4]}\n"
-                       "runs: [configs/smoke.yaml]\n");
+  const auto each =
+      smoke_sweep("ea", "each: {override: 'seed={}', values: [3, 4]}\nruns: [configs/smoke.yaml]\n");
   const Result ea = run("sweep " + each.string());
   ASSERT_EQ(ea.status, 0) << ea.err;
   const std::string each_table = read_file(dir / "tables" / "ea.md");
