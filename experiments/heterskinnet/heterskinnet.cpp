@@ -33,6 +33,12 @@ HeterSkinNet::Options HeterSkinNet::Options::from(const config::Node& node) {
   config::Fields f(node, "model heterskinnet");
   o.read(f);
   o.edge_dropout = graph::EdgeDropoutOptions::from(f.section("edge_dropout"));
+  f.optional("prior", o.prior);
+  f.optional("prior_bias", o.prior_bias);
+  f.optional("prior_epsilon", o.prior_epsilon);
+  f.check(o.prior_epsilon > 0, "prior_epsilon", "must be positive");
+  f.check(!o.prior_bias || !o.prior.empty() || !node["prior_bias"].exists(), "prior_bias",
+          "needs a `prior`");
   f.finish();
   o.fill_missing_branches(kHeterSkinNetDefaults);
   return o;
@@ -45,7 +51,8 @@ HeterSkinNet::HeterSkinNet(Options options) : options_(std::move(options)) {
       "global_branch",
       graph::graph_op_from(
           options_.global));  // "global" is a Python keyword: libtorch checkpoints cannot store it
-  const graph::Dims in{options_.top_k + 3, 6, options_.top_k};
+  const std::int64_t prior_inputs = options_.prior.empty() ? 0 : options_.top_k;
+  const graph::Dims in{options_.top_k + 3 + prior_inputs, 6, options_.top_k};
   const graph::Dims x = stem_->build(in);
   const graph::Dims g = global_->build(x);
   const graph::Dims l = local_->build(x);
@@ -69,9 +76,24 @@ torch::Tensor HeterSkinNet::forward(const data::CharacterTensors& c) {
   graph::Graph g = graph::make_graph(c);
   if (is_training() && options_.edge_dropout.p > 0) g = graph::drop_edges(g, options_.edge_dropout);
 
+  torch::Tensor prior;  // #V×K, the prior's weight on each candidate
+  if (!options_.prior.empty()) {
+    const auto it = c.priors.find(options_.prior);
+    if (it == c.priors.end()) {
+      std::string have;
+      for (const auto& [key, p] : c.priors) have += (have.empty() ? "" : ", ") + key;
+      TORCH_CHECK(false, "heterskinnet: character '", c.name, "' has no '", options_.prior,
+                  "' prior (it has: ", have.empty() ? "none" : have,
+                  "); prepare its dataset with preprocess.priors: [{type: ", options_.prior, "}]");
+    }
+    prior = it->second;
+  }
+
+  std::vector<torch::Tensor> vertex_inputs{
+      c.positions, models::inverse_distance(c.topk_distance, options_)};
+  if (prior.defined()) vertex_inputs.push_back(prior);
   graph::Features in;
-  in.vertex =
-      torch::cat({c.positions, models::inverse_distance(c.topk_distance, options_)}, 1);
+  in.vertex = torch::cat(vertex_inputs, 1);
   in.bone = c.bones;
   const graph::Features x = stem_->forward(in, g);
   const graph::Features glob = global_->forward(x, g);
@@ -79,14 +101,19 @@ torch::Tensor HeterSkinNet::forward(const data::CharacterTensors& c) {
   // The head's input is [local vertex ‖ its K candidates' local bone features ‖ global]; the
   // global part is one row broadcast to all vertices when global_pool does not keep its input.
   const bool broadcast = glob.vertex.size(0) == nv && glob.vertex.stride(0) == 0;
+  torch::Tensor logits;
   if (broadcast) {
-    return torch::softmax(
-        head_->forward_gathered(loc.vertex, loc.bone, c.topk_index, glob.vertex.narrow(0, 0, 1)),
-        1);
+    logits =
+        head_->forward_gathered(loc.vertex, loc.bone, c.topk_index, glob.vertex.narrow(0, 0, 1));
+  } else {
+    const torch::Tensor candidates =
+        loc.bone.index_select(0, c.topk_index.reshape({-1})).reshape({nv, k * loc.bone.size(1)});
+    logits = head_->forward(torch::cat({loc.vertex, candidates, glob.vertex}, 1));
   }
-  const torch::Tensor candidates =
-      loc.bone.index_select(0, c.topk_index.reshape({-1})).reshape({nv, k * loc.bone.size(1)});
-  return torch::softmax(head_->forward(torch::cat({loc.vertex, candidates, glob.vertex}, 1)), 1);
+  if (prior.defined() && options_.prior_bias) {
+    logits = logits + torch::log(prior + options_.prior_epsilon);
+  }
+  return torch::softmax(logits, 1);
 }
 
 }  // namespace skinlab::experiments

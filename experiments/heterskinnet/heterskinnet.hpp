@@ -29,12 +29,27 @@
 /// [b2v, v2b, mesh_conv, edge_conv] (RigNet's skinning network, whose GCU it adopts, uses three
 /// GCU blocks; the stem is the first).
 ///
+/// A prior (not in the paper): with `prior: bone_heat` the network starts from a classical
+/// method's weights, prepared into the dataset (data/preprocess.hpp step 4b, `preprocess.priors`).
+/// Its weight on the K candidates, p_v (#V×K, CharacterTensors::priors), is appended to f_v
+/// (2K + 3 inputs), and with `prior_bias` (default true) log(p_v + prior_epsilon) is added to the
+/// head's logits before the softmax:
+///
+///     w_v = softmax(MLP_head(h_v) + log(p_v + ε))
+///
+/// so a head that outputs zeros reproduces the prior renormalised over the K candidates, and
+/// training learns where artists depart from it (a multiplicative correction per candidate).
+/// ε (1e-3) bounds the correction needed to give weight to a candidate the prior leaves at 0
+/// (|log ε| ≈ 6.9). Motivation, measured: on games from unseen sources bone heat had lower L1
+/// than the network (experiments/heterskinnet/README.md, "Skinning beyond one game").
+///
 /// Ablations are configs: `configs/ablations/no_heterconv.yaml` lists `local`/`stem` without the
 /// `b2v`/`v2b` ops (the head still reads the K candidates' bone features: without an
 /// inter-graph conv those are the bone attributes processed by skeleton convs only).
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "framework/core/config.hpp"
@@ -52,6 +67,9 @@ class HeterSkinNet final : public models::Model {
   /// paper's widths), head [1024, 512] and head_dropout 0.5: models/branched_model.hpp.
   struct Options : models::BranchedModelOptions {
     graph::EdgeDropoutOptions edge_dropout;
+    std::string prior;           ///< a key of CharacterTensors::priors; empty: none (the paper)
+    bool prior_bias = true;      ///< add log(p + prior_epsilon) to the logits (needs `prior`)
+    double prior_epsilon = 1e-3;
     static Options from(const config::Node& node);
   };
   explicit HeterSkinNet(Options options);

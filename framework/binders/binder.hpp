@@ -11,6 +11,8 @@
 /// Implementations live in `baselines/<key>/<key>.{hpp,cpp}` and register with
 /// `SKINLAB_REGISTER(binder, <key>, Class)`.
 
+#include <string>
+
 #include <Eigen/Core>
 
 #include "framework/geometry/mesh.hpp"
@@ -28,5 +30,11 @@ class Binder {
   virtual Eigen::MatrixXd bind(const geometry::Mesh& mesh,
                                const geometry::Skeleton& skeleton) const = 0;
 };
+
+/// Checks a binder's result against the contract of Binder::bind: #V×#B (`num_vertices` ×
+/// `num_bones`), entries ≥ 0, rows summing to 1 within 1e-4. Throws Error starting with `what`
+/// (the binder and the character) and naming the first bad vertex.
+void check_weights(const Eigen::MatrixXd& W, int num_vertices, int num_bones,
+                   const std::string& what);
 
 }  // namespace skinlab::binders

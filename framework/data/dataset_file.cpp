@@ -71,6 +71,7 @@ void write_character(H5Writer& w, const PreparedCharacter& c) {
     w.write(dg + "/targets", d.targets);
   }
   w.create_group(g + "/distances");
+  for (const auto& [type, P] : c.priors) w.write(g + "/priors/" + type, P);
   w.write(g + "/edges/one_ring", c.one_ring_edges);
   w.write(g + "/edges/geodesic", c.geodesic_edges);
   w.write(g + "/laplacian/indices", c.laplacian_indices);
@@ -236,6 +237,16 @@ PreparedCharacter read_character(const H5Reader& r, const std::string& name) {
     check.shape(dg + "/targets", d.targets, nv, k);
     check.finite(dg + "/targets", values_of(d.targets));
     c.distances.emplace(type, std::move(d));
+  }
+  if (r.has(g + "/priors")) {
+    for (const auto& type : r.children(g + "/priors")) {
+      const std::string pg = g + "/priors/" + type;
+      RowMatrixXf P = r.read_float(pg);
+      check.shape(pg, P, nv, nb);
+      check.finite(pg, values_of(P));
+      if (P.size() > 0 && P.minCoeff() < 0) check.fail(pg, "has negative weights");
+      c.priors.emplace(type, std::move(P));
+    }
   }
 
   c.one_ring_edges = r.read_int(g + "/edges/one_ring");

@@ -87,6 +87,10 @@ struct PreparedCharacter {
   int subdivision_levels = 0;
   /// Per distance registry key (e.g. "hollow_dist").
   std::map<std::string, DistanceData> distances;
+  /// Per binder registry key (e.g. "bone_heat"): #V×#B weights of that classical method on this
+  /// mesh and these bones (preprocess.hpp step 4b), rows summing to 1. Empty unless the dataset
+  /// was prepared with `preprocess.priors`.
+  std::map<std::string, RowMatrixXf> priors;
   RowMatrixXi one_ring_edges;  ///< #E×2 directed edges (i, j), both directions of every edge
   RowMatrixXi geodesic_edges;  ///< #E_g×2 directed edges (i, j), geodesic radius 0.06, cap 10
   /// Uniform Laplacian L = D − A (laplacian.hpp) as #N triplets, row-major order.

@@ -10,6 +10,7 @@
 #include <optional>
 #include <set>
 
+#include "framework/binders/binder.hpp"
 #include "framework/core/environment.hpp"
 #include "framework/core/error.hpp"
 #include "framework/core/progress.hpp"
@@ -143,6 +144,7 @@ PrepareConfig PrepareConfig::from(const config::Config& config) {
   c.output = output;
   for (const auto& node : c.sources) dataset_registry().create(node);  // validates options
   make_distances(c.distances);
+  for (const auto& node : c.preprocess.priors) binder_registry().create(node);  // validates
   c.preparation = "preprocess:\n" + indent(preprocess.exists() ? preprocess.to_yaml() : "{}") +
                   "distances:\n" + indent(distances.to_yaml());
   return c;

@@ -5,8 +5,11 @@
 #include <cstdint>
 #include <limits>
 #include <numeric>
+#include <set>
 
+#include "framework/binders/binder.hpp"
 #include "framework/core/error.hpp"
+#include "framework/core/registry.hpp"
 #include "framework/geometry/average_vertex_data.hpp"
 #include "framework/geometry/geodesic_neighbours.hpp"
 #include "framework/geometry/laplacian.hpp"
@@ -31,6 +34,19 @@ PreprocessOptions PreprocessOptions::from(const config::Node& node) {
   f.optional("drop_weightless_leaves", o.drop_weightless_leaves);
   f.optional("drop_seed", o.drop_seed);
   o.augment = AugmentOptions::from(f.section("augment"));
+  const config::Node priors = f.section("priors");
+  if (priors.exists()) {
+    if (!priors.is_sequence()) priors.fail("expected a list of binder nodes ({type: <key>, ...})");
+    std::set<std::string> types;
+    for (std::size_t i = 0; i < priors.size(); ++i) {
+      const config::Node node = priors[i];
+      const std::string type = node.required_type("binder");
+      if (!types.insert(type).second) {
+        node.fail("prior '" + type + "' is listed twice (one entry per binder type)");
+      }
+      o.priors.push_back(node);
+    }
+  }
   f.check(o.merge_tolerance >= 0, "merge_tolerance", "must be ≥ 0");
   f.check(o.min_vertices >= 0, "min_vertices", "must be ≥ 0");
   f.check(o.max_vertices >= o.min_vertices, "max_vertices", "must be ≥ min_vertices");
@@ -41,6 +57,23 @@ PreprocessOptions PreprocessOptions::from(const config::Node& node) {
           "drop_weightless_leaves", "must be a probability in [0, 1]");
   f.finish();
   return o;
+}
+
+PreprocessOptions keep_prior(PreprocessOptions options, const std::string& keep) {
+  std::vector<config::Node> kept;
+  std::string listed;
+  for (const auto& node : options.priors) {
+    const std::string type = node.required_type("binder");
+    listed += (listed.empty() ? "" : ", ") + type;
+    if (type == keep) kept.push_back(node);
+  }
+  if (!keep.empty() && kept.empty()) {
+    throw ConfigError("the model reads the prior '" + keep + "', which the preparation does not " +
+                      "compute (its preprocess.priors: " + (listed.empty() ? "none" : listed) +
+                      "); prepare the dataset with preprocess.priors: [{type: " + keep + "}]");
+  }
+  options.priors = std::move(kept);
+  return options;
 }
 
 bool drops_weightless_leaves(const PreprocessOptions& options, const std::string& name) {
@@ -255,6 +288,15 @@ PreparedCharacter preprocess(const datasets::SourceCharacter& source,
       }
     }
     out.distances.emplace(named.type, std::move(d));
+  }
+
+  // 4b. Priors: a binder's weights on the same mesh and bones.
+  for (const auto& node : options.priors) {
+    const std::string type = node.required_type("binder");
+    const Eigen::MatrixXd P = binder_registry().create(node)->bind(mesh, c.skeleton);
+    binders::check_weights(P, mesh.num_vertices(), static_cast<int>(bones.size()),
+                           "binder '" + type + "' on " + where);
+    out.priors.emplace(type, P.cast<float>());
   }
 
   lap(times != nullptr ? &times->distance : nullptr);

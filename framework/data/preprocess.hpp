@@ -18,6 +18,9 @@
 ///    mesh, joints and leaf tips and normalise again (augment.hpp);
 /// 4. per distance type of the config: D (#V×#B), the top-K candidate bones per vertex (K = 3,
 ///    Sec. 3.2) with their distances, and bone-level targets over the K candidates;
+/// 4b. per `priors` entry (not in the paper): the #V×#B weights of a `binder` plug-in (e.g.
+///    bone heat, binders/binder.hpp) on the same mesh and bones, for models that start from a
+///    classical method's weights (PreparedCharacter::priors);
 /// 5. one-ring edges (Eq. 2, N_m), geodesic neighbour edges (radius 0.06, at most 10; N_g) and
 ///    the uniform Laplacian of the smoothing loss (Sec. 3.4, Eq. 6) as triplets.
 ///
@@ -64,6 +67,11 @@ struct PreprocessOptions {
   /// Augmented training copies (augment.hpp; `copies: 0`, the default, is off). Made by
   /// `skinlab prepare` for the characters some split trains on (prepare.hpp).
   AugmentOptions augment;
+  /// Step 4b: `binder` nodes ({type: <key>, ...}), each type at most once; empty (the default,
+  /// the paper) computes none. Kept as nodes and created by `preprocess`, so reading a
+  /// preparation does not need the binder plug-ins linked (skinlab-predict); `prepare` checks
+  /// that every entry can be created before it starts.
+  std::vector<config::Node> priors;
 
   /// Decodes a `preprocess:` map (every field optional); errors name the file, line and key.
   static PreprocessOptions from(const config::Node& node);
@@ -99,13 +107,18 @@ struct PreprocessMode {
 /// Wall-clock seconds of the steps of one `preprocess` call.
 struct PreprocessTimes {
   double normalise = 0;  ///< steps 1–3: normalise, merge, subdivide
-  double distance = 0;   ///< step 4: distances, top-K and targets
+  double distance = 0;   ///< steps 4 and 4b: distances, top-K, targets and priors
   double graph = 0;      ///< step 5: one-ring and geodesic edges, Laplacian
 };
 
 /// True when `drop_weightless_leaves` applies to the character `name` (a hash of the name and
 /// `drop_seed` against the probability; the same answer on every machine).
 bool drops_weightless_leaves(const PreprocessOptions& options, const std::string& name);
+
+/// `options` without the priors other than `keep` (empty: without any). Throws ConfigError naming
+/// the prior when `keep` is not among them, e.g. for a model that reads a prior its dataset was
+/// not prepared with.
+PreprocessOptions keep_prior(PreprocessOptions options, const std::string& keep);
 
 /// Runs steps 0–5 on `source` (which must carry weights unless `mode.require_weights` is
 /// false). Throws (GeometryError, IoError) with the character's name in the message when any

@@ -74,17 +74,8 @@ torch::Tensor bind_weights(const binders::Binder& binder, const std::string& typ
                            const data::PreparedCharacter& c) {
   const auto [mesh, skeleton] = geometry_of(c);
   const Eigen::MatrixXd W = binder.bind(mesh, skeleton);
-  if (W.rows() != c.V.rows() || W.cols() != c.bones.rows()) {
-    throw Error(fmt::format("binder '{}' returned {}×{} weights for '{}', expected {}×{}", type,
-                            W.rows(), W.cols(), c.name, c.V.rows(), c.bones.rows()));
-  }
-  for (Eigen::Index v = 0; v < W.rows(); ++v) {
-    const double sum = W.row(v).sum();
-    if (!(W.row(v).minCoeff() >= 0) || !(std::abs(sum - 1.0) < 1e-4)) {
-      throw Error(fmt::format("binder '{}' on '{}': vertex {} has weights summing to {} (min {})",
-                              type, c.name, v, sum, W.row(v).minCoeff()));
-    }
-  }
+  binders::check_weights(W, c.num_vertices(), c.num_bones(),
+                         fmt::format("binder '{}' on '{}'", type, c.name));
   const data::RowMatrixXf Wf = W.cast<float>();
   return torch::from_blob(const_cast<float*>(Wf.data()), {Wf.rows(), Wf.cols()}, torch::kFloat32)
       .clone();

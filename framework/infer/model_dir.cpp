@@ -73,10 +73,15 @@ std::string read_preparation(const fs::path& dir, const std::string& data_file) 
 }
 
 Preparation parse_preparation(const std::string& yaml, const fs::path& file, const fs::path& dir,
-                              const std::string& distance) {
+                              const std::string& distance, const std::string& prior) {
   const config::Config preparation = config::Config::parse(yaml, file.string());
   Preparation p;
-  p.preprocess = data::PreprocessOptions::from(preparation.root()["preprocess"]);
+  try {
+    p.preprocess = data::keep_prior(
+        data::PreprocessOptions::from(preparation.root()["preprocess"]), prior);
+  } catch (const ConfigError& e) {
+    throw ConfigError(dir.string() + ": " + e.what());
+  }
   const config::Node distances = preparation.root()["distances"];
   for (std::size_t i = 0; i < distances.size(); ++i) {
     const config::Node node = distances[i];

@@ -37,7 +37,10 @@ std::string read_preparation(const std::filesystem::path& dir, const std::string
 
 /// The preprocessing options of `yaml` (read_preparation's; `file` names it in errors) and
 /// the distance plug-in `distance` it lists. ConfigError naming `dir` when it does not list it.
+/// Of its priors (preprocess.priors) only `prior`, the one the model reads, is kept (empty:
+/// none, so predicting never runs a binder the model ignores); ConfigError when it is missing.
 Preparation parse_preparation(const std::string& yaml, const std::filesystem::path& file,
-                              const std::filesystem::path& dir, const std::string& distance);
+                              const std::filesystem::path& dir, const std::string& distance,
+                              const std::string& prior = "");
 
 }  // namespace skinlab::infer

@@ -672,6 +672,12 @@ Network Network::from(const ParameterFile& parameters, const fs::path& file) {
                        parameters.model));
   }
   const Json& arch = parameters.architecture;
+  if (arch.contains("prior")) {
+    s.fail(fmt::format("the model reads the '{}' prior (a classical method's weights, "
+                       "model.prior), which the Eigen forward pass of skinlab-predict does not "
+                       "compute; use skinlab predict",
+                       arch["prior"].is_string() ? arch["prior"].get<std::string>() : "?"));
+  }
   auto impl = std::make_unique<Impl>();
   impl->top_k = s.value<Index>(arch, "top_k", "the architecture");
   impl->distance_unit = s.value<double>(arch, "distance_unit", "the architecture");

@@ -70,6 +70,8 @@ infer::ParameterFile parameter_file(const models::Model& model, const train::Run
   a["top_k"] = options.top_k;
   a["distance_unit"] = options.distance_unit;
   a["min_distance"] = options.min_distance;
+  const config::Node prior = run.model["prior"];
+  if (prior.exists() && !prior.as<std::string>().empty()) a["prior"] = prior.as<std::string>();
   for (const auto& child : model.named_children()) {
     if (const auto* sequence = dynamic_cast<const graph::Sequence*>(child.value().get())) {
       Json ops = Json::array();

@@ -76,6 +76,13 @@ CharacterTensors to_tensors(const PreparedCharacter& character, const std::strin
     t.bone_weights = to_float(RowMatrixXd(Wb));
   }
 
+  for (const auto& [type, P] : character.priors) {
+    if (P.rows() != nv || P.cols() != nb) {
+      throw IoError(where + ": prior '" + type + "' is not #V×#B");
+    }
+    t.priors.emplace(type, to_float(P).gather(1, t.topk_index));
+  }
+
   const RowMatrixXd segments = skeleton.bone_segments();  // Sec. 3.2's bone attribute
   t.bones = to_float(segments);
   t.bone_joints = to_long(character.bones);

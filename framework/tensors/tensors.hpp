@@ -15,6 +15,7 @@
 
 #include <torch/torch.h>
 
+#include <map>
 #include <string>
 
 #include "framework/data/dataset_file.hpp"
@@ -37,6 +38,10 @@ struct CharacterTensors {
   /// #V×#B float32 full ground-truth bone weights, rows sum to 1; undefined for a character
   /// prepared without weights (for prediction)
   torch::Tensor bone_weights;
+  /// Per prior the character was prepared with (PreparedCharacter::priors, e.g. "bone_heat"):
+  /// #V×K float32, that method's weight on each candidate bone; a row sums to ≤ 1 (its weight on
+  /// other bones is not there). Empty for a file prepared without priors.
+  std::map<std::string, torch::Tensor> priors;
   torch::Tensor bones;         ///< #B×6 float32 bone attribute [start xyz, end xyz] (Sec. 3.2)
   torch::Tensor bone_joints;   ///< #B×2 int64 (start, end) joint of each bone
   torch::Tensor one_ring;      ///< #E×2 int64 mesh edges (N_m of Eq. 2)

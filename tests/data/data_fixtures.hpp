@@ -110,6 +110,7 @@ inline void expect_equal(const data::PreparedCharacter& a, const data::PreparedC
     EXPECT_EQ(d.topk_distance, e.topk_distance);
     EXPECT_EQ(d.targets, e.targets);
   }
+  EXPECT_EQ(a.priors, b.priors);
   EXPECT_EQ(a.one_ring_edges, b.one_ring_edges);
   EXPECT_EQ(a.geodesic_edges, b.geodesic_edges);
   EXPECT_EQ(a.laplacian_indices, b.laplacian_indices);

@@ -31,6 +31,10 @@ data::Dataset tiny_dataset() {
   d.characters[1].leaf_tips = d.characters[1].joints;
   d.characters[1].leaf_tips.bottomRows(1).array() += 0.25;
   d.characters[1].augmented_from = "alpha";  // as an augmented copy (alpha's, say)
+  // beta carries a prior (preprocess.priors); alpha has none.
+  const data::PreparedCharacter& b = d.characters[1];
+  d.characters[1].priors["bone_heat"] =
+      data::RowMatrixXf::Constant(b.num_vertices(), b.num_bones(), 1.0F / b.num_bones());
   d.splits["random"] = {{0}, {}, {1}};
   d.splits["by_skeleton"] = {{1}, {0}, {}};
   d.excluded = {{"folder", "bad.fbx", "bad.fbx: cannot read"}, {"zeroad", "x.pmd", "no bones"}};
@@ -118,6 +122,21 @@ TEST(DatasetFile, LeafTipsOfTheWrongShapeNameTheDataset) {
   data::write_dataset(dir / "t.h5", d);
   expect_error<IoError>([&] { data::read_dataset(dir / "t.h5"); },
                         {"t.h5", "'/characters/beta/leaf_tips'"});
+}
+
+TEST(DatasetFile, APriorOfTheWrongShapeOrSignNamesTheDataset) {
+  TempDir dir;
+  data::Dataset d = tiny_dataset();
+  data::RowMatrixXf& prior = d.characters[1].priors.at("bone_heat");
+  prior.conservativeResize(prior.rows(), prior.cols() - 1);
+  data::write_dataset(dir / "p.h5", d);
+  expect_error<IoError>([&] { data::read_dataset(dir / "p.h5"); },
+                        {"p.h5", "'/characters/beta/priors/bone_heat'"});
+  d = tiny_dataset();
+  d.characters[1].priors.at("bone_heat")(2, 0) = -0.5F;
+  data::write_dataset(dir / "n.h5", d);
+  expect_error<IoError>([&] { data::read_dataset(dir / "n.h5"); },
+                        {"n.h5", "'/characters/beta/priors/bone_heat'", "negative"});
 }
 
 TEST(DatasetFile, TheBindPoseIsKeptWithOrWithoutClipsAndCheckedForShape) {
@@ -271,7 +290,7 @@ TEST(DatasetFile, ReadableByH5py) {
       "    for i in range(len(p) - 1):\n"
       "        if i == 0 and p[0] in ('characters', 'splits'):\n"
       "            p[1] = '<name>' if p[0] == 'characters' else '<split>'\n"
-      "        if p[i] == 'distances': p[i + 1] = '<type>'\n"
+      "        if p[i] in ('distances', 'priors'): p[i + 1] = '<type>'\n"
       "        if p[i] == 'animations': p[i + 1] = '<k>'\n"
       "    return '/'.join(p)\n"
       "seen = set()\n"
@@ -287,7 +306,7 @@ TEST(DatasetFile, ReadableByH5py) {
       "doc = open(sys.argv[2]).read()\n"
       "words = set(re.split(r'[/ ,{}()<>@]+', ' '.join(re.findall(r'`([^`]+)`', doc))))\n"
       "for item in sorted(seen):\n"
-      "    leaf = re.split('[/@]', item.split(' ')[1])[-1]\n"
+      "    leaf = re.split('[/@]', item.split(' ')[1])[-1].strip('<>')\n"
       "    print(item if leaf in words else item + ' (undocumented)')\n";
   const auto py = dir.write("check.py", script);
   const std::string command = "/usr/bin/python3 '" + py.string() + "' '" + (dir / "d.h5").string() +
@@ -333,6 +352,7 @@ TEST(DatasetFile, ReadableByH5py) {
             "dataset characters/<name>/leaf_tips\n"
             "dataset characters/<name>/normalisation\n"
             "dataset characters/<name>/parents\n"
+      "dataset characters/<name>/priors/<type>\n"
             "dataset characters/<name>/vertex_map\n"
             "dataset characters/<name>/weights/indices\n"
             "dataset characters/<name>/weights/indptr\n"

@@ -1,0 +1,26 @@
+#include "framework/binders/binder.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "framework/core/error.hpp"
+
+namespace skinlab::binders {
+
+void check_weights(const Eigen::MatrixXd& W, int num_vertices, int num_bones,
+                   const std::string& what) {
+  if (W.rows() != num_vertices || W.cols() != num_bones) {
+    throw Error(fmt::format("{} returned {}×{} weights, expected {}×{}", what, W.rows(), W.cols(),
+                            num_vertices, num_bones));
+  }
+  for (Eigen::Index v = 0; v < W.rows(); ++v) {
+    const double sum = W.row(v).sum();
+    if (!(W.row(v).minCoeff() >= 0) || !(std::abs(sum - 1.0) < 1e-4)) {
+      throw Error(fmt::format("{}: vertex {} has weights summing to {} (min {})", what, v, sum,
+                              W.row(v).minCoeff()));
+    }
+  }
+}
+
+}  // namespace skinlab::binders

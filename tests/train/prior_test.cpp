@@ -1,0 +1,186 @@
+// Priors (data/preprocess.hpp step 4b): a classical method's weights (bone heat) prepared into
+// the dataset, gathered on the candidates, and read by HeterSkinNet with `model.prior`
+// (experiments/heterskinnet/heterskinnet.hpp); training, prediction, and the Eigen forward pass
+// refusing such a model.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "framework/binders/binder.hpp"
+#include "framework/core/error.hpp"
+#include "framework/core/registry.hpp"
+#include "framework/infer/network.hpp"
+#include "framework/infer/parameters.hpp"
+#include "framework/models/model.hpp"
+#include "framework/predict/predictor.hpp"
+#include "framework/tensors/tensors.hpp"
+#include "framework/tensors/threads.hpp"
+#include "framework/train/trainer.hpp"
+#include "tests/test_util.hpp"
+#include "tests/train/train_fixtures.hpp"
+
+namespace skinlab {
+namespace {
+namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
+
+namespace fs = std::filesystem;
+using testing::expect_error;
+
+// The tubes' preparation (train_fixtures.hpp: prepared_tube) with bone heat as a prior.
+constexpr const char* kPreprocess =
+    "{min_vertices: 100, max_vertices: 2000, top_k: 3, priors: [{type: bone_heat}]}";
+
+data::PreparedCharacter tube_with_bone_heat(int index) {
+  const auto euclidean =
+      distance_registry().create(config::Config::parse("type: euclidean").root());
+  return data::preprocess(testing::tube_character(index), {{"euclidean", euclidean}},
+                          data::PreprocessOptions::from(config::Config::parse(kPreprocess).root()));
+}
+
+// configs/smoke.yaml's tiny HeterSkinNet, plus `extra` model fields.
+std::string tiny_heterskinnet(const std::string& extra) {
+  return "{type: heterskinnet, top_k: 3, head: [16, 8], " + extra +
+         "stem: [{type: b2v, mlp: [8]}, {type: v2b, mlp: [8]}, "
+         "{type: mesh_conv, edge_mlp: [8], mlp: [8]}, {type: edge_conv, edges: skeleton, mlp: [8]}], "
+         "local: [{type: b2v, mlp: [8]}, {type: v2b, mlp: [8]}], "
+         "global: {type: global_pool, vertex_mlp: [8], bone_mlp: [8], to: [vertex], "
+         "keep_input: false}}";
+}
+
+std::shared_ptr<models::Model> make_model(const std::string& extra) {
+  return model_registry().create(config::Config::parse(tiny_heterskinnet(extra)).root());
+}
+
+/// The model's forward pass in eval mode with every parameter of its head set to zero.
+torch::Tensor forward_with_zero_head(models::Model& model, const data::CharacterTensors& c) {
+  torch::NoGradGuard no_grad;
+  for (auto& p : model.named_parameters()) {
+    if (p.key().rfind("head.", 0) == 0) p.value().zero_();
+  }
+  model.eval();
+  return model.forward(c);
+}
+
+TEST(Prior, IsTheBindersWeightsOnThePreparedMeshAndBones) {
+  const data::PreparedCharacter c = tube_with_bone_heat(0);
+  ASSERT_EQ(c.priors.size(), 1u);
+  const data::RowMatrixXf& P = c.priors.at("bone_heat");
+  ASSERT_EQ(P.rows(), c.num_vertices());
+  ASSERT_EQ(P.cols(), c.num_bones());
+  geometry::Mesh mesh;
+  mesh.V = c.V;
+  mesh.F = c.F;
+  const Eigen::MatrixXd expected =
+      binder_registry().create(config::Config::parse("type: bone_heat").root())->bind(mesh, c.rig());
+  EXPECT_LT((P.cast<double>() - expected).cwiseAbs().maxCoeff(), 1e-6);
+  EXPECT_LT((P.rowwise().sum().array() - 1.0F).abs().maxCoeff(), 1e-4);
+  // Everything else is the preparation without priors.
+  const data::PreparedCharacter plain = testing::prepared_tube(0);
+  EXPECT_TRUE(plain.priors.empty());
+  EXPECT_EQ(plain.V, c.V);
+  EXPECT_EQ(plain.distances.at("euclidean").targets, c.distances.at("euclidean").targets);
+}
+
+TEST(Prior, TensorsHoldItsWeightOnEachCandidate) {
+  const data::PreparedCharacter c = tube_with_bone_heat(1);
+  const data::CharacterTensors t = data::to_tensors(c, "euclidean");
+  ASSERT_EQ(t.priors.count("bone_heat"), 1u);
+  const torch::Tensor p = t.priors.at("bone_heat");
+  ASSERT_EQ(p.sizes(), (std::vector<std::int64_t>{c.num_vertices(), 3}));
+  const auto a = p.accessor<float, 2>();
+  const data::DistanceData& d = c.distances.at("euclidean");
+  for (int v = 0; v < c.num_vertices(); ++v) {
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_EQ(a[v][k], c.priors.at("bone_heat")(v, d.topk_index(v, k))) << v << ", " << k;
+    }
+  }
+  EXPECT_TRUE(data::to_tensors(testing::prepared_tube(1), "euclidean").priors.empty());
+}
+
+TEST(Prior, OptionsNameTheBadEntryAndKeepOnlyWhatTheModelReads) {
+  const auto options = [](const std::string& yaml) {
+    return data::PreprocessOptions::from(config::Config::parse(yaml, "p.yaml").root());
+  };
+  expect_error<ConfigError>([&] { options("priors: [{type: bone_heat}, {type: bone_heat}]"); },
+                            {"p.yaml", "'bone_heat' is listed twice"});
+  expect_error<ConfigError>([&] { options("priors: {type: bone_heat}"); },
+                            {"p.yaml", "list of binder nodes"});
+  expect_error<ConfigError>([&] { options("priors: [{heat: 1}]"); }, {"p.yaml", "'type'"});
+
+  const data::PreprocessOptions both = options("priors: [{type: bone_heat}, {type: geo_voxel}]");
+  ASSERT_EQ(data::keep_prior(both, "geo_voxel").priors.size(), 1u);
+  EXPECT_EQ(data::keep_prior(both, "geo_voxel").priors[0].required_type("binder"), "geo_voxel");
+  EXPECT_TRUE(data::keep_prior(both, "").priors.empty());
+  expect_error<ConfigError>([&] { data::keep_prior(both, "magic"); },
+                            {"'magic'", "bone_heat, geo_voxel", "preprocess.priors"});
+  expect_error<ConfigError>([&] { data::keep_prior(options("{}"), "bone_heat"); },
+                            {"'bone_heat'", "none"});
+}
+
+TEST(Prior, AHeadOfZerosGivesThePriorRenormalisedOverTheCandidates) {
+  set_torch_threads(1);
+  const data::CharacterTensors c = data::to_tensors(tube_with_bone_heat(2), "euclidean");
+  const torch::Tensor q = c.priors.at("bone_heat") + 1e-3;  // prior_epsilon's default
+  const auto with_bias = make_model("prior: bone_heat, ");
+  EXPECT_TRUE(torch::allclose(forward_with_zero_head(*with_bias, c), q / q.sum(1, true), 1e-5,
+                              1e-7));
+  // Without the bias the prior is an input only: a zero head gives every candidate 1/K.
+  const auto input_only = make_model("prior: bone_heat, prior_bias: false, ");
+  EXPECT_TRUE(torch::allclose(forward_with_zero_head(*input_only, c),
+                              torch::full({c.num_vertices(), 3}, 1.0 / 3), 1e-6, 1e-7));
+  // The prior is an input too: the first layer of the stem reads K more vertex features.
+  const auto params = [](const models::Model& m) {
+    std::int64_t n = 0;
+    for (const auto& p : m.parameters()) n += p.numel();
+    return n;
+  };
+  EXPECT_GT(params(*with_bias), params(*make_model("")));
+}
+
+TEST(Prior, AModelReadingAPriorTheCharacterLacksNamesBoth) {
+  const auto model = make_model("prior: bone_heat, ");
+  const data::CharacterTensors c = data::to_tensors(testing::prepared_tube(0), "euclidean");
+  expect_error<c10::Error>([&] { model->forward(c); },
+                           {"'tube_0'", "'bone_heat'", "preprocess.priors: [{type: bone_heat}]"});
+  expect_error<ConfigError>([&] { make_model("prior_bias: true, "); }, {"prior_bias", "prior"});
+  expect_error<ConfigError>([&] { make_model("prior: bone_heat, prior_epsilon: 0, "); },
+                            {"prior_epsilon", "positive"});
+}
+
+TEST(Prior, TrainsPredictsWithTheRunsPreparationAndIsRefusedBySkinlabPredict) {
+  set_torch_threads(2);
+  testing::TempDir dir;
+  data::Dataset d;
+  for (int i = 0; i < 3; ++i) d.characters.push_back(tube_with_bone_heat(i));
+  d.splits["random"] = {{0, 1}, {2}, {}};
+  d.preparation = std::string("preprocess: ") + kPreprocess + "\ndistances: [{type: euclidean}]\n";
+  data::write_dataset(dir / "tubes.h5", d);
+  const config::Config config = config::Config::parse(
+      "experiment: prior\nseed: 3\nresults_dir: " + (dir / "results").string() +
+      "\nmodel: " + tiny_heterskinnet("prior: bone_heat, ") +
+      "\nlosses: [{type: soft_cross_entropy, weight: 1.0}]\n"
+      "data: {file: " + (dir / "tubes.h5").string() + ", split: random, distance: euclidean}\n"
+      "train: {epochs: 2, lr: 1.0e-3, patience: 0, log_every: 0}\n");
+  train::Trainer trainer(config);
+  const RunDir run = train::create_run(config, trainer.options(), "p", {"test"});
+  trainer.fit(run);
+
+  // Prediction prepares the new character with the run's preparation, bone heat included.
+  const predict::Predictor predictor = predict::Predictor::load(run.path());
+  const predict::Prediction p = predictor.predict(testing::tube_character(5).character);
+  ASSERT_EQ(p.prepared.priors.count("bone_heat"), 1u);
+  const Eigen::VectorXd sums = p.joint_weights.toDense().rowwise().sum();
+  EXPECT_LT((sums.array() - 1.0).abs().maxCoeff(), 1e-5);
+
+  // skinlab-predict's Eigen forward pass does not compute priors: the parameter file records
+  // the prior and loading it is an error that says what to use instead.
+  predictor.write_parameters(dir / "parameters.h5");
+  const infer::ParameterFile file = infer::read_parameter_file(dir / "parameters.h5");
+  expect_error<Error>([&] { infer::Network::from(file, dir / "parameters.h5"); },
+                      {"'bone_heat' prior", "skinlab predict"});
+}
+
+}  // namespace SKINLAB_UNITY_ID
+}  // namespace
+}  // namespace skinlab
