@@ -55,6 +55,11 @@ Json describe(const graph::GraphOp& op) {
 
 }  // namespace
 
+std::string model_prior(const train::RunOptions& run) {
+  const config::Node prior = run.model["prior"];
+  return prior.exists() ? prior.as<std::string>() : "";
+}
+
 infer::ParameterFile parameter_file(const models::Model& model, const train::RunOptions& run,
                                     const std::string& source) {
   infer::ParameterFile p;
@@ -70,8 +75,7 @@ infer::ParameterFile parameter_file(const models::Model& model, const train::Run
   a["top_k"] = options.top_k;
   a["distance_unit"] = options.distance_unit;
   a["min_distance"] = options.min_distance;
-  const config::Node prior = run.model["prior"];
-  if (prior.exists() && !prior.as<std::string>().empty()) a["prior"] = prior.as<std::string>();
+  if (const std::string prior = model_prior(run); !prior.empty()) a["prior"] = prior;
   for (const auto& child : model.named_children()) {
     if (const auto* sequence = dynamic_cast<const graph::Sequence*>(child.value().get())) {
       Json ops = Json::array();

@@ -23,6 +23,10 @@
 
 namespace skinlab::predict {
 
+/// The prior `run`'s model reads (`model.prior`, e.g. "bone_heat"; data/preprocess.hpp step 4b),
+/// empty when it reads none. The parameter file records it; prediction computes only it.
+std::string model_prior(const train::RunOptions& run);
+
 /// The parameter file of `model` (built from `run`'s config); `source` is its provenance.
 infer::ParameterFile parameter_file(const models::Model& model, const train::RunOptions& run,
                                     const std::string& source);

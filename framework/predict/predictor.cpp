@@ -55,10 +55,9 @@ Predictor Predictor::load(const fs::path& dir, const std::string& checkpoint) {
     }
   }
 
-  const config::Node prior = p.options_.model["prior"];
   p.preparation_ = infer::parse_preparation(infer::read_preparation(dir, p.options_.data.file),
                                             dir / "preparation.yaml", dir, p.options_.data.distance,
-                                            prior.exists() ? prior.as<std::string>() : "");
+                                            model_prior(p.options_));
 
   p.model_ = train::build_model(p.options_);
   const train::TrainingState state = train::load_checkpoint(weights, *p.model_);
