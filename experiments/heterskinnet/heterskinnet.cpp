@@ -31,14 +31,9 @@ global: {type: global_pool, vertex_mlp: [512], bone_mlp: [512], to: [vertex], ke
 HeterSkinNet::Options HeterSkinNet::Options::from(const config::Node& node) {
   Options o;
   config::Fields f(node, "model heterskinnet");
-  o.read(f);
+  o.BranchedModelOptions::read(f);
+  o.PriorOptions::read(f);
   o.edge_dropout = graph::EdgeDropoutOptions::from(f.section("edge_dropout"));
-  f.optional("prior", o.prior);
-  f.optional("prior_bias", o.prior_bias);
-  f.optional("prior_epsilon", o.prior_epsilon);
-  f.check(o.prior_epsilon > 0, "prior_epsilon", "must be positive");
-  f.check(!o.prior_bias || !o.prior.empty() || !node["prior_bias"].exists(), "prior_bias",
-          "needs a `prior`");
   f.finish();
   o.fill_missing_branches(kHeterSkinNetDefaults);
   return o;

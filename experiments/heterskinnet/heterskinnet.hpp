@@ -65,11 +65,8 @@ class HeterSkinNet final : public models::Model {
  public:
   /// top_k (K = 3, Sec. 4.2), distance_unit, min_distance, stem/local/global (missing: the
   /// paper's widths), head [1024, 512] and head_dropout 0.5: models/branched_model.hpp.
-  struct Options : models::BranchedModelOptions {
+  struct Options : models::BranchedModelOptions, models::PriorOptions {
     graph::EdgeDropoutOptions edge_dropout;
-    std::string prior;           ///< a key of CharacterTensors::priors; empty: none (the paper)
-    bool prior_bias = true;      ///< add log(p + prior_epsilon) to the logits (needs `prior`)
-    double prior_epsilon = 1e-3;
     static Options from(const config::Node& node);
   };
   explicit HeterSkinNet(Options options);

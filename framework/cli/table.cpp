@@ -1,6 +1,6 @@
 /// \file
 /// `skinlab table <run_dir>... [--part test] [--format md|csv|tex] [--metrics a,b] [--title T]
-/// [--out file] [--group-runs] [--across-splits]`: the comparison table of saved, evaluated runs
+/// [--out file] [--group-runs] [--across-splits] [--same-data FROM=TO]...`: the comparison table of saved, evaluated runs
 /// (framework/report/table.hpp); the first run is the reference of the ANOVA columns. Without
 /// --out it prints the table.
 
@@ -10,6 +10,7 @@
 #include "framework/cli/commands.hpp"
 #include "framework/task/task.hpp"
 #include "framework/core/atomic_file.hpp"
+#include "framework/core/error.hpp"
 #include "framework/report/table.hpp"
 
 namespace skinlab::cli {
@@ -23,6 +24,7 @@ Command add_table(CLI::App& app) {
     std::string part = "test";
     std::string out;
     report::TableOptions options;
+    std::vector<std::string> same_data;
   };
   auto args = std::make_shared<Args>();
   cmd->add_option("runs", args->runs, "run directories; the first is the reference")->required();
@@ -37,9 +39,20 @@ Command add_table(CLI::App& app) {
                 "runs of one experiment (seeds) form one row: mean ± sd across the runs");
   cmd->add_flag("--across-splits", args->options.across_splits,
                 "generalisation table: methods x the test sets the runs were evaluated on");
+  cmd->add_option("--same-data", args->same_data,
+                  "FROM=TO: runs evaluated on dataset file FROM count as evaluated on TO (e.g. a "
+                  "dataset prepared again with priors added: the same characters and splits); "
+                  "the table still requires the same test characters");
   return {cmd, [args] {
             std::vector<report::RunResult> runs;
             for (const auto& dir : args->runs) runs.push_back(report::load_run_result(dir, args->part));
+            for (const auto& pair : args->same_data) {
+              const auto eq = pair.find('=');
+              if (eq == std::string::npos || eq == 0 || eq + 1 == pair.size()) {
+                throw ConfigError("table: --same-data '" + pair + "' is not FROM=TO");
+              }
+              report::count_as_same_data(runs, pair.substr(0, eq), pair.substr(eq + 1));
+            }
             std::string command;
             for (std::size_t i = 1; i < command_line().size(); ++i) {
               const std::string& word = command_line()[i];

@@ -44,6 +44,28 @@ data::RowMatrixXf forward(const Network& network, const data::PreparedCharacter&
   in.num_geodesic = c.geodesic_edges.rows();
   in.bones = c.bones.data();
   in.bone_segments = segments.data();
+  data::RowMatrixXf prior;  // #V×K: the prior's weight on each candidate (as CharacterTensors::priors)
+  if (!network.prior().empty()) {
+    const auto p = c.priors.find(network.prior());
+    if (p == c.priors.end()) {
+      throw Error(fmt::format("{}: the model reads the '{}' prior, which its preparation did "
+                              "not compute (preprocess.priors)",
+                              c.name, network.prior()));
+    }
+    if (p->second.rows() != c.num_vertices() || p->second.cols() != c.num_bones()) {
+      throw Error(fmt::format("{}: the '{}' prior is {}×{}, not #V×#B = {}×{}", c.name,
+                              network.prior(), p->second.rows(), p->second.cols(),
+                              c.num_vertices(), c.num_bones()));
+    }
+    prior.resize(in.num_vertices, in.top_k);
+    for (Eigen::Index v = 0; v < prior.rows(); ++v) {
+      for (Eigen::Index j = 0; j < prior.cols(); ++j) {
+        const int b = d.topk_index(v, j);
+        prior(v, j) = b >= 0 && b < c.num_bones() ? p->second(v, b) : 0.0f;
+      }
+    }
+    in.prior = prior.data();
+  }
   const std::vector<float> out = network.forward(in);
   return Eigen::Map<const data::RowMatrixXf>(out.data(), in.num_vertices, in.top_k);
 }
@@ -74,8 +96,9 @@ EigenPredictor EigenPredictor::load(const fs::path& dir) {
     const config::Node data = config::Config::load(config_file).root()["data"]["file"];
     if (data.exists()) data_file = data.as<std::string>();
   }
-  Preparation preparation = parse_preparation(read_preparation(dir, data_file),
-                                              dir / "preparation.yaml", dir, parameters.distance);
+  Preparation preparation =
+      parse_preparation(read_preparation(dir, data_file), dir / "preparation.yaml", dir,
+                        parameters.distance, network.prior());
   if (preparation.preprocess.top_k != network.top_k()) {
     throw ConfigError(fmt::format("{}: the preparation picks {} candidate bones per vertex, but "
                                   "the network of {} takes K = {}",

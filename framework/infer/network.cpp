@@ -644,6 +644,9 @@ void softmax_rows(Matrix& m) {
 
 struct Network::Impl {
   Index top_k = 0;
+  std::string prior;  ///< empty: the model reads none
+  bool prior_bias = false;
+  float prior_epsilon = 0;
   double distance_unit = 1.0 / 88.0, min_distance = 1.0;
   std::vector<std::unique_ptr<Op>> stem, local;
   std::unique_ptr<Op> global;
@@ -657,6 +660,7 @@ Network& Network::operator=(Network&&) noexcept = default;
 Network::~Network() = default;
 
 int Network::top_k() const { return static_cast<int>(impl_->top_k); }
+const std::string& Network::prior() const { return impl_->prior; }
 
 Network Network::from(const ParameterFile& parameters, const fs::path& file) {
 #if defined(__AVX2__) && defined(__FMA__)
@@ -672,20 +676,24 @@ Network Network::from(const ParameterFile& parameters, const fs::path& file) {
                        parameters.model));
   }
   const Json& arch = parameters.architecture;
-  if (arch.contains("prior")) {
-    s.fail(fmt::format("the model reads the '{}' prior (a classical method's weights, "
-                       "model.prior), which the Eigen forward pass of skinlab-predict does not "
-                       "compute; use skinlab predict",
-                       arch["prior"].is_string() ? arch["prior"].get<std::string>() : "?"));
-  }
   auto impl = std::make_unique<Impl>();
+  if (arch.contains("prior")) {
+    impl->prior = s.value<std::string>(arch, "prior", "the architecture");
+    impl->prior_bias = s.value<bool>(arch, "prior_bias", "the architecture");
+    const auto epsilon = s.value<double>(arch, "prior_epsilon", "the architecture");
+    if (impl->prior.empty() || !(epsilon > 0)) {
+      s.fail("architecture: prior must name a binder and prior_epsilon be positive");
+    }
+    impl->prior_epsilon = static_cast<float>(epsilon);
+  }
   impl->top_k = s.value<Index>(arch, "top_k", "the architecture");
   impl->distance_unit = s.value<double>(arch, "distance_unit", "the architecture");
   impl->min_distance = s.value<double>(arch, "min_distance", "the architecture");
   if (impl->top_k < 1 || !(impl->distance_unit > 0) || !(impl->min_distance > 0)) {
     s.fail("architecture: top_k, distance_unit and min_distance must be positive");
   }
-  Widths w{impl->top_k + 3, 6, impl->top_k};
+  const Index prior_inputs = impl->prior.empty() ? 0 : impl->top_k;
+  Widths w{impl->top_k + 3 + prior_inputs, 6, impl->top_k};
   impl->stem = make_sequence(s, "stem", w);
   Widths g = w;
   impl->global = make_op(s, "global_branch",
@@ -720,6 +728,10 @@ std::vector<float> Network::forward(const NetworkInput& c) const {
     throw Error(fmt::format("{}: {} vertices and {} bones; the network needs both", c.name, nv,
                             nb));
   }
+  if (!n.prior.empty() && c.prior == nullptr) {
+    throw Error(fmt::format("{}: the model reads the '{}' prior, which was not computed for it",
+                            c.name, n.prior));
+  }
   const IndexMap topk(c.topk_index, nv, n.top_k);
   for (Index v = 0; v < nv; ++v) {
     for (Index j = 0; j < n.top_k; ++j) {
@@ -743,8 +755,9 @@ std::vector<float> Network::forward(const NetworkInput& c) const {
   using DoubleMap = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic,
                                                    Eigen::RowMajor>>;
   const Eigen::Map<const Matrix> distance(c.topk_distance, nv, n.top_k);
+  const Index prior_inputs = n.prior.empty() ? 0 : n.top_k;
   Features x;
-  x.vertex.resize(nv, 3 + n.top_k);
+  x.vertex.resize(nv, 3 + n.top_k + prior_inputs);
   x.vertex.leftCols(3) = DoubleMap(c.positions, nv, 3).cast<float>();
   const auto unit = static_cast<float>(n.distance_unit);
   const auto least = static_cast<float>(n.min_distance);
@@ -752,6 +765,11 @@ std::vector<float> Network::forward(const NetworkInput& c) const {
     for (Index j = 0; j < n.top_k; ++j) {
       x.vertex(v, 3 + j) = 1.0f / std::max(distance(v, j) / unit, least);
     }
+  }
+  Matrix prior;  // #V×K
+  if (prior_inputs > 0) {
+    prior = Eigen::Map<const Matrix>(c.prior, nv, n.top_k);
+    x.vertex.rightCols(prior_inputs) = prior;
   }
   x.bone = DoubleMap(c.bone_segments, nb, 6).cast<float>();
 
@@ -764,6 +782,7 @@ std::vector<float> Network::forward(const NetworkInput& c) const {
   }
   const Features l = run(n.local, std::move(x), g);
   Matrix out = n.head.forward(l.vertex, l.bone, topk, shared);
+  if (prior_inputs > 0 && n.prior_bias) out.array() += (prior.array() + n.prior_epsilon).log();
   softmax_rows(out);
   return std::vector<float>(out.data(), out.data() + out.size());
 }

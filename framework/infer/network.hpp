@@ -9,6 +9,9 @@
 ///     x   = stem(f_v, f_b);   G = global(x);   l = local(x)
 ///     w_v = softmax(MLP_head(l_v ‖ l_b[n_v,1] ‖ … ‖ l_b[n_v,K] ‖ G))
 ///
+/// and for a model trained with a prior (models::PriorOptions, not in the paper) q_v, a
+/// classical method's weight on the K candidates: f_v = [p ‖ 1/D ‖ q_v] (2K + 3) and, with
+/// `prior_bias`, w_v = softmax(MLP_head(…) + log(q_v + prior_epsilon));
 /// with the graph ops of the libtorch implementation (framework/graph/), each the same map:
 ///   - `b2v` (Eq. 5): MLP(f_v ‖ f_{b_{n_v,1}} ‖ … ‖ f_{b_{n_v,K}}), layer 0 split by weight
 ///     blocks so the bone blocks cost #B rows (graph/mlp.hpp, forward_gathered);
@@ -56,6 +59,7 @@ struct NetworkInput {
   std::int64_t num_geodesic = 0;          ///< #E_g
   const int* bones = nullptr;             ///< #B×2 (start, end) joints
   const double* bone_segments = nullptr;  ///< #B×6 [start, end] (Sec. 3.2's bone attribute)
+  const float* prior = nullptr;  ///< #V×K: Network::prior()'s weight on each candidate, if any
 };
 
 class Network {
@@ -67,11 +71,13 @@ class Network {
   static Network from(const ParameterFile& parameters, const std::filesystem::path& file);
 
   /// #V×K row-major: the softmax over the candidate bones of every vertex of `input`. Error
-  /// naming the character for a K other than the model's, a candidate that is not a bone or an
-  /// edge that is not between two nodes.
+  /// naming the character for a K other than the model's, a candidate that is not a bone, an
+  /// edge that is not between two nodes, or a missing `prior` when the model reads one.
   std::vector<float> forward(const NetworkInput& input) const;
 
   int top_k() const;
+  /// The prior the model reads (a binder's registry key, e.g. "bone_heat"); empty: none.
+  const std::string& prior() const;
 
   Network(Network&&) noexcept;
   Network& operator=(Network&&) noexcept;

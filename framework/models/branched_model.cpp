@@ -21,6 +21,15 @@ void BranchedModelOptions::read(config::Fields& f) {
   f.check(head_dropout >= 0 && head_dropout < 1, "head_dropout", "must be in [0, 1)");
 }
 
+void PriorOptions::read(config::Fields& f) {
+  const bool bias_given = f.section("prior_bias").exists();
+  f.optional("prior", prior);
+  f.optional("prior_bias", prior_bias);
+  f.optional("prior_epsilon", prior_epsilon);
+  f.check(prior_epsilon > 0, "prior_epsilon", "must be positive");
+  f.check(!prior_bias || !prior.empty() || !bias_given, "prior_bias", "needs a `prior`");
+}
+
 void BranchedModelOptions::fill_missing_branches(const char* defaults_yaml) {
   static std::mutex mutex;
   static std::map<const char*, config::Config> parsed;

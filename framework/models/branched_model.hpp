@@ -41,6 +41,22 @@ struct BranchedModelOptions {
   void fill_missing_branches(const char* defaults_yaml);
 };
 
+/// A prior a model may start from (not in the papers): `prior` names one of the priors a
+/// dataset was prepared with (data/preprocess.hpp step 4b, CharacterTensors::priors), p_v its
+/// weight on the K candidates (#V×K). A model reading it appends p_v to its vertex input and,
+/// with `prior_bias`, adds log(p_v + prior_epsilon) to its logits before the softmax
+/// (experiments/heterskinnet/heterskinnet.hpp). Here so the parameter export
+/// (predict/parameter_export.hpp) records exactly what skinlab-predict's forward pass must apply.
+struct PriorOptions {
+  std::string prior;         ///< a key of CharacterTensors::priors; empty: none (the papers)
+  bool prior_bias = true;    ///< add log(p + prior_epsilon) to the logits (needs `prior`)
+  double prior_epsilon = 1e-3;
+
+  /// Reads and checks `prior`, `prior_bias` and `prior_epsilon` from `f` (call before
+  /// `f.finish()`): ConfigError for prior_epsilon ≤ 0 or a `prior_bias` without a `prior`.
+  void read(config::Fields& f);
+};
+
 /// #V×K: 1 / max(D / distance_unit, min_distance) of the candidates' distances (#V×K metres).
 torch::Tensor inverse_distance(const torch::Tensor& topk_distance,
                                const BranchedModelOptions& options);

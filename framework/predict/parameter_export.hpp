@@ -12,12 +12,14 @@
 /// type is written with its type only, which the Eigen side refuses by name. Every MLP of the
 /// model (graph/mlp.hpp) is listed under `mlps` by module path with its input width, widths and
 /// last activation. `top_k`, `distance_unit` and `min_distance` are the model's options
-/// (models/branched_model.hpp: HeterSkinNet's K and 1/D input, Sec. 3.2 and 4.2).
+/// (models/branched_model.hpp: HeterSkinNet's K and 1/D input, Sec. 3.2 and 4.2); a model
+/// reading a prior adds `prior`, `prior_bias` and `prior_epsilon` (models::PriorOptions).
 
 #include <filesystem>
 #include <string>
 
 #include "framework/infer/parameters.hpp"
+#include "framework/models/branched_model.hpp"
 #include "framework/models/model.hpp"
 #include "framework/train/run_options.hpp"
 
@@ -26,6 +28,9 @@ namespace skinlab::predict {
 /// The prior `run`'s model reads (`model.prior`, e.g. "bone_heat"; data/preprocess.hpp step 4b),
 /// empty when it reads none. The parameter file records it; prediction computes only it.
 std::string model_prior(const train::RunOptions& run);
+/// All of the prior's options (models::PriorOptions: prior, prior_bias, prior_epsilon) of
+/// `run`'s model, as the parameter file records them.
+models::PriorOptions model_prior_options(const train::RunOptions& run);
 
 /// The parameter file of `model` (built from `run`'s config); `source` is its provenance.
 infer::ParameterFile parameter_file(const models::Model& model, const train::RunOptions& run,

@@ -279,6 +279,17 @@ RunResult load_run_result(const fs::path& dir, const std::string& part) {
   return r;
 }
 
+void count_as_same_data(std::vector<RunResult>& runs, const std::string& from, const std::string& to) {
+  int renamed = 0;
+  for (auto& run : runs) {
+    if (run.dataset == from) {
+      run.dataset = to;
+      ++renamed;
+    }
+  }
+  if (renamed == 0) throw Error("table: no run was evaluated on `" + from + "` (--same-data)");
+}
+
 std::string make_table(const std::vector<RunResult>& runs, const TableOptions& options) {
   if (runs.empty()) throw Error("table: no runs given");
   if (options.across_splits) return make_split_table(runs, options);

@@ -61,6 +61,13 @@ struct TableOptions {
   bool across_splits = false;
 };
 
+/// Counts the runs evaluated on dataset file `from` as evaluated on `to` (`skinlab table
+/// --same-data FROM=TO`): for a dataset prepared again with additions only (e.g. priors,
+/// configs/datasets/games_all_prior.yaml on games_all.yaml), whose test parts are the same
+/// characters, so its runs share the columns of the other file's runs; the table still checks
+/// the characters. Throws Error when no run was evaluated on `from`.
+void count_as_same_data(std::vector<RunResult>& runs, const std::string& from, const std::string& to);
+
 /// The table text (see the file comment). Throws Error for fewer than one run, an unknown
 /// format, a metric missing from a run (naming both), or runs on different characters.
 std::string make_table(const std::vector<RunResult>& runs, const TableOptions& options);

@@ -208,6 +208,19 @@ TEST(Table, AcrossSplitsHasAColumnPerTestSetAndTheirUnion) {
   testing::expect_error<Error>(
       [&] { report::make_table({runs[0], run("other", {"a", "e"}, {0.1, 0.2}, "leave_out_x")}, o); },
       {"evaluated on other characters", "'e' where"});
+
+  // A dataset prepared again with additions (priors) is another file: its own column, unless
+  // --same-data counts it as the first file; the characters are still checked.
+  std::vector<report::RunResult> again{runs[0], run("prior", {"a", "b"}, {0.9, 0.9}, "leave_out_x")};
+  again[1].dataset = "d_prior.h5";
+  EXPECT_NE(report::make_table(again, o).find("| Precision ↑ | d leave_out_x | d_prior leave_out_x |"),
+            std::string::npos);
+  report::count_as_same_data(again, "d_prior.h5", "d.h5");
+  EXPECT_NE(report::make_table(again, o).find("| prior | 90.00% (p "), std::string::npos)
+      << report::make_table(again, o);
+  EXPECT_EQ(report::make_table(again, o).find("all test sets"), std::string::npos);
+  testing::expect_error<Error>([&] { report::count_as_same_data(again, "d_prior.h5", "d.h5"); },
+                               {"no run was evaluated on `d_prior.h5`"});
 }
 
 }  // namespace SKINLAB_UNITY_ID

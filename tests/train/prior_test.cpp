@@ -1,7 +1,7 @@
 // Priors (data/preprocess.hpp step 4b): a classical method's weights (bone heat) prepared into
 // the dataset, gathered on the candidates, and read by HeterSkinNet with `model.prior`
-// (experiments/heterskinnet/heterskinnet.hpp); training, prediction, and the Eigen forward pass
-// refusing such a model.
+// (experiments/heterskinnet/heterskinnet.hpp); training, and prediction through libtorch and
+// through skinlab-predict's Eigen forward pass.
 
 #include <gtest/gtest.h>
 
@@ -10,6 +10,7 @@
 #include "framework/binders/binder.hpp"
 #include "framework/core/error.hpp"
 #include "framework/core/registry.hpp"
+#include "framework/infer/eigen_predictor.hpp"
 #include "framework/infer/network.hpp"
 #include "framework/infer/parameters.hpp"
 #include "framework/models/model.hpp"
@@ -148,7 +149,7 @@ TEST(Prior, AModelReadingAPriorTheCharacterLacksNamesBoth) {
                             {"prior_epsilon", "positive"});
 }
 
-TEST(Prior, TrainsPredictsWithTheRunsPreparationAndIsRefusedBySkinlabPredict) {
+TEST(Prior, TrainsAndPredictsWithTheRunsPreparationInLibtorchAndEigen) {
   set_torch_threads(2);
   testing::TempDir dir;
   data::Dataset d;
@@ -173,12 +174,29 @@ TEST(Prior, TrainsPredictsWithTheRunsPreparationAndIsRefusedBySkinlabPredict) {
   const Eigen::VectorXd sums = p.joint_weights.toDense().rowwise().sum();
   EXPECT_LT((sums.array() - 1.0).abs().maxCoeff(), 1e-5);
 
-  // skinlab-predict's Eigen forward pass does not compute priors: the parameter file records
-  // the prior and loading it is an error that says what to use instead.
-  predictor.write_parameters(dir / "parameters.h5");
-  const infer::ParameterFile file = infer::read_parameter_file(dir / "parameters.h5");
-  expect_error<Error>([&] { infer::Network::from(file, dir / "parameters.h5"); },
-                      {"'bone_heat' prior", "skinlab predict"});
+  // skinlab-predict: the parameter file records the prior, and the Eigen forward pass, with
+  // the prior computed by the binder the bundle's preparation names, equals libtorch's.
+  predictor.write_parameters(run.path() / "parameters.h5");
+  const infer::ParameterFile file = infer::read_parameter_file(run.path() / "parameters.h5");
+  EXPECT_EQ(file.architecture.at("prior"), "bone_heat");
+  EXPECT_EQ(file.architecture.at("prior_bias"), true);
+  EXPECT_DOUBLE_EQ(file.architecture.at("prior_epsilon").get<double>(), 1e-3);
+  const infer::EigenPredictor eigen = infer::EigenPredictor::load(run.path());
+  const predict::Prediction e = eigen.predict(testing::tube_character(5).character);
+  ASSERT_EQ(e.prepared.priors.count("bone_heat"), 1u);
+  ASSERT_EQ(e.candidates.rows(), p.candidates.rows());
+  ASSERT_EQ(e.candidates.cols(), p.candidates.cols());
+  EXPECT_LE((e.candidates - p.candidates).cwiseAbs().maxCoeff(), 1e-5);
+  // The prior moves the answer: the same network with a zero prior gives other weights.
+  data::PreparedCharacter without = e.prepared;
+  without.priors.at("bone_heat").setZero();
+  const infer::Network network = infer::Network::from(file, run.path() / "parameters.h5");
+  EXPECT_GT((infer::forward(network, without, "euclidean") - e.candidates).cwiseAbs().maxCoeff(),
+            1e-3);
+  // A character prepared without the prior is an error naming it and the prior.
+  without.priors.clear();
+  expect_error<Error>([&] { infer::forward(network, without, "euclidean"); },
+                      {without.name, "'bone_heat' prior"});
 }
 
 }  // namespace SKINLAB_UNITY_ID
