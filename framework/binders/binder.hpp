@@ -31,6 +31,18 @@ class Binder {
                                const geometry::Skeleton& skeleton) const = 0;
 };
 
+/// Two `binder:` types that are not binders, and not in the registry: the reference itself,
+/// scored as a prediction by the evaluator (eval/evaluator.hpp), the ceilings of the metrics.
+/// `artist_weights`: the artist's own #V×#B weights, pruned by each metric like any prediction
+/// (precision 1; recall is the share of influential entries that survive `prune`).
+inline constexpr const char* kArtistWeights = "artist_weights";
+/// `artist_candidates`: the training targets, the artist's weights on the K candidate bones
+/// renormalised (data/preprocess.hpp step 4): the best a K-candidate network can output.
+inline constexpr const char* kArtistCandidates = "artist_candidates";
+inline bool is_artist_reference(const std::string& type) {
+  return type == kArtistWeights || type == kArtistCandidates;
+}
+
 /// Checks a binder's result against the contract of Binder::bind: #V×#B (`num_vertices` ×
 /// `num_bones`), entries ≥ 0, rows summing to 1 within 1e-4. Throws Error starting with `what`
 /// (the binder and the character) and naming the first bad vertex.

@@ -141,8 +141,8 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
   std::int64_t epoch = 0;
   std::unique_ptr<losses::LossSum> loss;
   if (is_binder) {
-    binder = binder_registry().create(o.binder);
-    method_type = o.binder["type"].as<std::string>();
+    method_type = o.binder.required_type("binder");
+    if (!binders::is_artist_reference(method_type)) binder = binder_registry().create(o.binder);
   } else {
     model = train::build_model(o);
     epoch = train::load_checkpoint(checkpoint, *model).epoch;
@@ -187,7 +187,13 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
         data.dataset().characters[static_cast<std::size_t>(index)];
     const data::CharacterTensors& c = data.tensors(index);
     torch::Tensor candidates, weights;
-    if (is_binder) {
+    if (method_type == binders::kArtistWeights) {
+      weights = c.bone_weights;
+      candidates = weights.gather(1, c.topk_index);
+    } else if (method_type == binders::kArtistCandidates) {
+      candidates = c.targets;
+      weights = data::scatter_to_bones(candidates, c.topk_index, c.num_bones());
+    } else if (is_binder) {
       weights = bind_weights(*binder, method_type, character);
       candidates = weights.gather(1, c.topk_index);  // the binder's weight on each candidate
     } else {

@@ -7,7 +7,8 @@
 /// of the config's `metrics:` list (metric.hpp), plus the training loss. A run whose config has
 /// a `binder:` instead of a `model:` (binders/binder.hpp: GeoVoxel, bone heat) gets its #V×#B
 /// weights from the binder, on the same characters and with the same metrics, and has no
-/// checkpoint and no loss. Per-character values
+/// checkpoint and no loss. Two binder types are not binders but the reference scored as a
+/// prediction, the ceilings of every metric (binders::kArtistWeights, kArtistCandidates). Per-character values
 /// are averaged over the characters (each character counts once, the RigNet-lineage
 /// convention).
 ///

@@ -87,7 +87,9 @@ RunOptions RunOptions::from(const config::Config& config) {
       o.binder.fail("a config has a 'model' (a network to train) or a 'binder' (weights from "
                     "geometry alone), not both");
     }
-    binder_registry().create(o.binder);
+    if (!binders::is_artist_reference(o.binder.required_type("binder"))) {
+      binder_registry().create(o.binder);
+    }
   }
   if (o.losses.exists()) losses::LossSum::from(o.losses);
   if (o.metrics.exists()) {

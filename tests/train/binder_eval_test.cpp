@@ -1,10 +1,12 @@
 // Evaluation of a `binder:` config (weights from geometry alone): the same characters, metrics
 // and output files as a trained model, no checkpoint and no loss, the binder's contract checked
-// (a bad row is an error naming the vertex), and `model` + `binder` in one config rejected.
+// (a bad row is an error naming the vertex), `model` + `binder` in one config rejected, and the
+// artist's own weights scored as a prediction (the ceilings).
 
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <map>
 
 #include "framework/binders/binder.hpp"
 #include "framework/core/atomic_file.hpp"
@@ -109,6 +111,40 @@ TEST(BinderEval, SameMetricsAndFilesAsAModelWithoutCheckpointOrLoss) {
   EXPECT_FALSE(json["mean"].contains("loss"));
   EXPECT_TRUE(fs::exists(run.file("predictions/test.h5")));
   EXPECT_TRUE(fs::exists(run.file("config.yaml")));
+}
+
+TEST(BinderEval, TheArtistsWeightsScoredAsAPredictionAreTheCeilings) {
+  TempDir dir;
+  const fs::path dataset = dir / "tubes.h5";
+  testing::write_tube_dataset(dataset, 1, 1, 2);
+  const std::string metrics =
+      "\nmetrics: [{type: precision_recall, threshold: 1.0e-4, prune: 0.25}, "
+      "{type: avg_l1, prune: 0}]\n";
+  std::map<std::string, eval::EvalReport> reports;
+  for (const char* type : {binders::kArtistWeights, binders::kArtistCandidates}) {
+    std::string text = binder_config(dataset, dir / "results", std::string("{type: ") + type + "}");
+    text.replace(text.find("\nmetrics:"), text.find("\ndata:") - text.find("\nmetrics:"), metrics);
+    const config::Config config = config::Config::parse(text, std::string(type) + ".yaml");
+    reports[type] = eval::evaluate(train::create_run(config, train::RunOptions::from(config), type, {"test"}), {});
+  }
+  train::RunData data(train::RunOptions::from(config::Config::parse(
+      binder_config(dataset, dir / "results", "{type: artist_weights}"))).data);
+  for (std::size_t i = 0; i < 2; ++i) {
+    const auto& artist = reports[binders::kArtistWeights].characters[i].values;
+    const auto& candidates = reports[binders::kArtistCandidates].characters[i].values;
+    // The artist's weights: every kept entry is influential, and unpruned they are the target.
+    EXPECT_DOUBLE_EQ(artist.at("precision"), 1.0);
+    EXPECT_NEAR(artist.at("avg_l1"), 0.0, 1e-6);
+    EXPECT_LE(artist.at("recall"), 1.0);
+    // The K-candidate targets: exactly the scattered training targets.
+    const auto& t = data.tensors(data.part("test").at(i));
+    const torch::Tensor targets = data::scatter_to_bones(t.targets, t.topk_index, t.num_bones());
+    EXPECT_NEAR(candidates.at("avg_l1"),
+                (targets - t.bone_weights).abs().sum(1).mean().item<double>(), 1e-5);
+    EXPECT_LE(candidates.at("recall"), 1.0);
+  }
+  // Not binders: no registry entry is needed, and the run says which reference it scored.
+  EXPECT_EQ(reports[binders::kArtistWeights].checkpoint, "none");
 }
 
 TEST(BinderEval, ABadRowIsAnErrorNamingTheVertex) {
