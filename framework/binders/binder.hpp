@@ -31,16 +31,23 @@ class Binder {
                                const geometry::Skeleton& skeleton) const = 0;
 };
 
-/// Two `binder:` types that are not binders, and not in the registry: the reference itself,
-/// scored as a prediction by the evaluator (eval/evaluator.hpp), the ceilings of the metrics.
+/// Three `binder:` types that are not binders, and not in the registry, computed by the
+/// evaluator (eval/evaluator.hpp) from the dataset file. Two are the reference itself, scored as
+/// a prediction: the ceilings of the metrics.
 /// `artist_weights`: the artist's own #V×#B weights, pruned by each metric like any prediction
 /// (precision 1; recall is the share of influential entries that survive `prune`).
 inline constexpr const char* kArtistWeights = "artist_weights";
 /// `artist_candidates`: the training targets, the artist's weights on the K candidate bones
 /// renormalised (data/preprocess.hpp step 4): the best a K-candidate network can output.
 inline constexpr const char* kArtistCandidates = "artist_candidates";
-inline bool is_artist_reference(const std::string& type) {
-  return type == kArtistWeights || type == kArtistCandidates;
+/// `prior_on_candidates` (with `prior: <binder type>`): a prior stored in the dataset file
+/// (data/preprocess.hpp step 4b) on the K candidates, renormalised (uniform where it is 0 on all
+/// K): what a model reading that prior starts from (HeterSkinNet with a zero head, up to its
+/// prior_epsilon), and a classical method restricted to the candidates of `data.distance`.
+inline constexpr const char* kPriorOnCandidates = "prior_on_candidates";
+/// Whether a `binder:` type is one of the three rows above, which the evaluator computes itself.
+inline bool is_reference_row(const std::string& type) {
+  return type == kArtistWeights || type == kArtistCandidates || type == kPriorOnCandidates;
 }
 
 /// Checks a binder's result against the contract of Binder::bind: #V×#B (`num_vertices` ×

@@ -81,6 +81,20 @@ torch::Tensor bind_weights(const binders::Binder& binder, const std::string& typ
       .clone();
 }
 
+/// #V×K: the stored prior `type` on the candidates, renormalised; uniform on a vertex where it
+/// is 0 on all K. Throws Error naming the character when it has no such prior.
+torch::Tensor prior_on_candidates(const data::CharacterTensors& c, const std::string& type) {
+  const auto it = c.priors.find(type);
+  if (it == c.priors.end()) {
+    throw Error(fmt::format("binder '{}': character '{}' has no '{}' prior; evaluate on a dataset "
+                            "prepared with preprocess.priors: [{{type: {}}}]",
+                            binders::kPriorOnCandidates, c.name, type, type));
+  }
+  const torch::Tensor sum = it->second.sum(1, true);
+  const torch::Tensor uniform = torch::full_like(it->second, 1.0 / static_cast<double>(c.top_k()));
+  return torch::where(sum > 0, it->second / sum.clamp_min(1e-30), uniform);
+}
+
 }  // namespace
 
 void write_eval_files(const RunDir& run, EvalReport& report, nlohmann::json header) {
@@ -137,12 +151,17 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
   }
   std::shared_ptr<models::Model> model;
   std::shared_ptr<binders::Binder> binder;
-  std::string method_type;
+  std::string method_type, prior_type;
   std::int64_t epoch = 0;
   std::unique_ptr<losses::LossSum> loss;
   if (is_binder) {
     method_type = o.binder.required_type("binder");
-    if (!binders::is_artist_reference(method_type)) binder = binder_registry().create(o.binder);
+    if (!binders::is_reference_row(method_type)) binder = binder_registry().create(o.binder);
+    if (method_type == binders::kPriorOnCandidates) {
+      config::Fields f(o.binder, std::string("binder ") + binders::kPriorOnCandidates);
+      f.required("prior", prior_type);
+      f.finish();
+    }
   } else {
     model = train::build_model(o);
     epoch = train::load_checkpoint(checkpoint, *model).epoch;
@@ -192,6 +211,9 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
       candidates = weights.gather(1, c.topk_index);
     } else if (method_type == binders::kArtistCandidates) {
       candidates = c.targets;
+      weights = data::scatter_to_bones(candidates, c.topk_index, c.num_bones());
+    } else if (method_type == binders::kPriorOnCandidates) {
+      candidates = prior_on_candidates(c, prior_type);
       weights = data::scatter_to_bones(candidates, c.topk_index, c.num_bones());
     } else if (is_binder) {
       weights = bind_weights(*binder, method_type, character);

@@ -7,8 +7,9 @@
 /// of the config's `metrics:` list (metric.hpp), plus the training loss. A run whose config has
 /// a `binder:` instead of a `model:` (binders/binder.hpp: GeoVoxel, bone heat) gets its #V×#B
 /// weights from the binder, on the same characters and with the same metrics, and has no
-/// checkpoint and no loss. Two binder types are not binders but the reference scored as a
-/// prediction, the ceilings of every metric (binders::kArtistWeights, kArtistCandidates). Per-character values
+/// checkpoint and no loss. Three binder types are rows the evaluator computes from the dataset
+/// file (binders::is_reference_row): the artist's weights and the training targets scored as a
+/// prediction (the ceilings of every metric), and a stored prior on the candidates. Per-character values
 /// are averaged over the characters (each character counts once, the RigNet-lineage
 /// convention).
 ///

@@ -87,7 +87,7 @@ RunOptions RunOptions::from(const config::Config& config) {
       o.binder.fail("a config has a 'model' (a network to train) or a 'binder' (weights from "
                     "geometry alone), not both");
     }
-    if (!binders::is_artist_reference(o.binder.required_type("binder"))) {
+    if (!binders::is_reference_row(o.binder.required_type("binder"))) {
       binder_registry().create(o.binder);
     }
   }

@@ -10,6 +10,7 @@
 #include "framework/binders/binder.hpp"
 #include "framework/core/error.hpp"
 #include "framework/core/registry.hpp"
+#include "framework/eval/evaluator.hpp"
 #include "framework/infer/eigen_predictor.hpp"
 #include "framework/infer/network.hpp"
 #include "framework/infer/parameters.hpp"
@@ -147,6 +148,48 @@ TEST(Prior, AModelReadingAPriorTheCharacterLacksNamesBoth) {
   expect_error<ConfigError>([&] { make_model("prior_bias: true, "); }, {"prior_bias", "prior"});
   expect_error<ConfigError>([&] { make_model("prior: bone_heat, prior_epsilon: 0, "); },
                             {"prior_epsilon", "positive"});
+}
+
+TEST(Prior, OnTheCandidatesIsAnEvaluatedRow) {
+  testing::TempDir dir;
+  data::Dataset d;
+  for (int i = 0; i < 2; ++i) d.characters.push_back(tube_with_bone_heat(i));
+  d.characters.push_back(testing::prepared_tube(2));  // without the prior
+  d.splits["random"] = {{}, {}, {0, 1}};
+  d.splits["no_prior"] = {{}, {}, {2}};
+  d.preparation = std::string("preprocess: ") + kPreprocess + "\ndistances: [{type: euclidean}]\n";
+  data::write_dataset(dir / "tubes.h5", d);
+  const std::string text =
+      "experiment: prior_row\nresults_dir: " + (dir / "results").string() +
+      "\nbinder: {type: prior_on_candidates, prior: bone_heat}\n"
+      "metrics: [{type: avg_l1, prune: 0}]\n"
+      "data: {file: " + (dir / "tubes.h5").string() + ", split: random, distance: euclidean}\n";
+  const config::Config config = config::Config::parse(text, "prior_row.yaml");
+  const train::RunOptions o = train::RunOptions::from(config);
+  const eval::EvalReport r = eval::evaluate(train::create_run(config, o, "r", {"test"}), {});
+  ASSERT_EQ(r.characters.size(), 2u);
+  for (int i = 0; i < 2; ++i) {
+    // By hand: the prior's weight on the candidates, renormalised, against the bone weights.
+    const data::CharacterTensors c = data::to_tensors(d.characters[i], "euclidean");
+    const torch::Tensor p = c.priors.at("bone_heat");
+    const torch::Tensor w = data::scatter_to_bones(p / p.sum(1, true), c.topk_index, c.num_bones());
+    EXPECT_NEAR(r.characters[i].values.at("avg_l1"),
+                (w - c.bone_weights).abs().sum(1).mean().item<double>(), 1e-5);
+  }
+  // A character without the prior, and a row without `prior:`, are errors naming what is missing.
+  const config::Config none = config::Config::parse(text + "\n", "none.yaml");
+  const RunDir run = train::create_run(none, train::RunOptions::from(none), "n", {"test"});
+  expect_error<Error>([&] { eval::evaluate(run, {{"test"}, "best", true, {"data.split=no_prior"}}); },
+                      {"'tube_2'", "no 'bone_heat' prior"});
+  const config::Config missing = config::Config::parse(
+      "experiment: prior_row\nbinder: {type: prior_on_candidates}\n"
+      "data: {file: " + (dir / "tubes.h5").string() + ", split: random, distance: euclidean}\n",
+      "missing.yaml");
+  expect_error<ConfigError>(
+      [&] {
+        eval::evaluate(train::create_run(missing, train::RunOptions::from(missing), "m", {"test"}), {});
+      },
+      {"prior"});
 }
 
 TEST(Prior, TrainsAndPredictsWithTheRunsPreparationInLibtorchAndEigen) {
