@@ -182,7 +182,8 @@ TEST(Prior, OnTheCandidatesIsAnEvaluatedRow) {
   expect_error<Error>([&] { eval::evaluate(run, {{"test"}, "best", true, {"data.split=no_prior"}}); },
                       {"'tube_2'", "no 'bone_heat' prior"});
   const config::Config missing = config::Config::parse(
-      "experiment: prior_row\nbinder: {type: prior_on_candidates}\n"
+      "experiment: prior_row\nresults_dir: " + (dir / "results").string() +
+          "\nbinder: {type: prior_on_candidates}\n"
       "data: {file: " + (dir / "tubes.h5").string() + ", split: random, distance: euclidean}\n",
       "missing.yaml");
   expect_error<ConfigError>(
