@@ -23,4 +23,13 @@ void check_weights(const Eigen::MatrixXd& W, int num_vertices, int num_bones,
   }
 }
 
+std::string reference_row_prior(const config::Node& node) {
+  const std::string type = node.required_type("binder");
+  config::Fields f(node, "binder " + type);
+  std::string prior;
+  if (type == kPriorOnCandidates) f.required("prior", prior);
+  f.finish();
+  return prior;
+}
+
 }  // namespace skinlab::binders

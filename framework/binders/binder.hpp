@@ -15,6 +15,7 @@
 
 #include <Eigen/Core>
 
+#include "framework/core/config.hpp"
 #include "framework/geometry/mesh.hpp"
 #include "framework/geometry/skeleton.hpp"
 
@@ -49,6 +50,10 @@ inline constexpr const char* kPriorOnCandidates = "prior_on_candidates";
 inline bool is_reference_row(const std::string& type) {
   return type == kArtistWeights || type == kArtistCandidates || type == kPriorOnCandidates;
 }
+/// Checks the fields of a reference row's node (`type`, and `prior` for prior_on_candidates;
+/// ConfigError naming the node for a missing or unknown field) and returns its `prior` (empty
+/// for the other two). Called when a config is read and by the evaluator.
+std::string reference_row_prior(const config::Node& node);
 
 /// Checks a binder's result against the contract of Binder::bind: #V×#B (`num_vertices` ×
 /// `num_bones`), entries ≥ 0, rows summing to 1 within 1e-4. Throws Error starting with `what`

@@ -156,11 +156,10 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
   std::unique_ptr<losses::LossSum> loss;
   if (is_binder) {
     method_type = o.binder.required_type("binder");
-    if (!binders::is_reference_row(method_type)) binder = binder_registry().create(o.binder);
-    if (method_type == binders::kPriorOnCandidates) {
-      config::Fields f(o.binder, std::string("binder ") + binders::kPriorOnCandidates);
-      f.required("prior", prior_type);
-      f.finish();
+    if (binders::is_reference_row(method_type)) {
+      prior_type = binders::reference_row_prior(o.binder);
+    } else {
+      binder = binder_registry().create(o.binder);
     }
   } else {
     model = train::build_model(o);

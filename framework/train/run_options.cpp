@@ -87,7 +87,9 @@ RunOptions RunOptions::from(const config::Config& config) {
       o.binder.fail("a config has a 'model' (a network to train) or a 'binder' (weights from "
                     "geometry alone), not both");
     }
-    if (!binders::is_reference_row(o.binder.required_type("binder"))) {
+    if (binders::is_reference_row(o.binder.required_type("binder"))) {
+      binders::reference_row_prior(o.binder);  // validates its fields
+    } else {
       binder_registry().create(o.binder);
     }
   }

@@ -145,6 +145,10 @@ TEST(BinderEval, TheArtistsWeightsScoredAsAPredictionAreTheCeilings) {
   }
   // Not binders: no registry entry is needed, and the run says which reference it scored.
   EXPECT_EQ(reports[binders::kArtistWeights].checkpoint, "none");
+  // Their fields are checked when the config is read: an unknown one names itself.
+  const config::Config extra = config::Config::parse(
+      binder_config(dataset, dir / "results", "{type: artist_weights, prior: bone_heat}"), "x.yaml");
+  testing::expect_error<ConfigError>([&] { train::RunOptions::from(extra); }, {"x.yaml", "prior"});
 }
 
 TEST(BinderEval, ABadRowIsAnErrorNamingTheVertex) {
