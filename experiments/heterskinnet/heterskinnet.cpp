@@ -72,17 +72,7 @@ torch::Tensor HeterSkinNet::forward(const data::CharacterTensors& c) {
   if (is_training() && options_.edge_dropout.p > 0) g = graph::drop_edges(g, options_.edge_dropout);
 
   torch::Tensor prior;  // #V×K, the prior's weight on each candidate
-  if (!options_.prior.empty()) {
-    const auto it = c.priors.find(options_.prior);
-    if (it == c.priors.end()) {
-      std::string have;
-      for (const auto& [key, p] : c.priors) have += (have.empty() ? "" : ", ") + key;
-      TORCH_CHECK(false, "heterskinnet: character '", c.name, "' has no '", options_.prior,
-                  "' prior (it has: ", have.empty() ? "none" : have,
-                  "); prepare its dataset with preprocess.priors: [{type: ", options_.prior, "}]");
-    }
-    prior = it->second;
-  }
+  if (!options_.prior.empty()) prior = data::prior_of(c, options_.prior, "heterskinnet");
 
   std::vector<torch::Tensor> vertex_inputs{
       c.positions, models::inverse_distance(c.topk_distance, options_)};

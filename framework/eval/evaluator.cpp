@@ -84,15 +84,11 @@ torch::Tensor bind_weights(const binders::Binder& binder, const std::string& typ
 /// #V×K: the stored prior `type` on the candidates, renormalised; uniform on a vertex where it
 /// is 0 on all K. Throws Error naming the character when it has no such prior.
 torch::Tensor prior_on_candidates(const data::CharacterTensors& c, const std::string& type) {
-  const auto it = c.priors.find(type);
-  if (it == c.priors.end()) {
-    throw Error(fmt::format("binder '{}': character '{}' has no '{}' prior; evaluate on a dataset "
-                            "prepared with preprocess.priors: [{{type: {}}}]",
-                            binders::kPriorOnCandidates, c.name, type, type));
-  }
-  const torch::Tensor sum = it->second.sum(1, true);
-  const torch::Tensor uniform = torch::full_like(it->second, 1.0 / static_cast<double>(c.top_k()));
-  return torch::where(sum > 0, it->second / sum.clamp_min(1e-30), uniform);
+  const torch::Tensor& prior =
+      data::prior_of(c, type, fmt::format("binder '{}'", binders::kPriorOnCandidates));
+  const torch::Tensor sum = prior.sum(1, true);
+  const torch::Tensor uniform = torch::full_like(prior, 1.0 / static_cast<double>(c.top_k()));
+  return torch::where(sum > 0, prior / sum.clamp_min(1e-30), uniform);
 }
 
 }  // namespace
@@ -228,11 +224,7 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
     r.vertices = static_cast<int>(c.num_vertices());
     r.bones = static_cast<int>(c.num_bones());
     if (loss) {
-      losses::LossInputs in;
-      in.pred = weights;
-      in.target = data::scatter_to_bones(c.targets, c.topk_index, c.num_bones());
-      in.laplacian = c.laplacian;
-      r.values["loss"] = (*loss)(in).item<double>();
+      r.values["loss"] = (*loss)(train::loss_inputs(c, weights)).item<double>();
     }
     MetricInputs mi;
     mi.pred = weights;

@@ -26,6 +26,10 @@ struct LossInputs {
   torch::Tensor pred{};     ///< #V×C prediction (for weights: rows are distributions)
   torch::Tensor target{};   ///< #V×C ground truth, same shape as `pred`
   torch::Tensor laplacian{};  ///< #V×#V mesh Laplacian (sparse COO or dense), for smoothing terms
+  /// Per prior the character was prepared with (e.g. "bone_heat"): that classical method's
+  /// weights laid out as `pred` (#V×C, zero outside the candidates), for terms that anchor the
+  /// prediction to it (prior_kl.hpp)
+  std::map<std::string, torch::Tensor> priors{};
 };
 
 /// Keys every `losses:` entry may carry besides the loss's own options.

@@ -1,5 +1,7 @@
 #include "framework/tensors/tensors.hpp"
 
+#include <fmt/format.h>
+
 #include "framework/core/error.hpp"
 #include "framework/data/preprocess.hpp"
 #include "framework/geometry/orient_outward.hpp"
@@ -101,6 +103,19 @@ CharacterTensors to_tensors(const PreparedCharacter& character, const std::strin
           .to(torch::kFloat32);
   t.laplacian = torch::sparse_coo_tensor(indices, values, {nv, nv}).coalesce();
   return t;
+}
+
+const torch::Tensor& prior_of(const CharacterTensors& c, const std::string& name,
+                              const std::string& who) {
+  const auto it = c.priors.find(name);
+  if (it == c.priors.end()) {
+    std::string have;
+    for (const auto& [key, p] : c.priors) have += (have.empty() ? "" : ", ") + key;
+    throw Error(fmt::format("{}: character '{}' has no '{}' prior (it has: {}); prepare its dataset "
+                            "with preprocess.priors: [{{type: {}}}]",
+                            who, c.name, name, have.empty() ? "none" : have, name));
+  }
+  return it->second;
 }
 
 torch::Tensor scatter_to_bones(const torch::Tensor& pred, const torch::Tensor& topk_index,

@@ -62,6 +62,12 @@ torch::Tensor to_float(const RowMatrixXd& m);
 /// An int64 copy of `m`, e.g. an #E×2 edge list.
 torch::Tensor to_long(const RowMatrixXi& m);
 
+/// `c`'s prior `name` (#V×K, CharacterTensors::priors). Throws Error naming the character, the
+/// priors it has and the preparation option that adds `name` (`preprocess.priors`); `who` (the
+/// model or binder asking) starts the message.
+const torch::Tensor& prior_of(const CharacterTensors& c, const std::string& name,
+                              const std::string& who);
+
 /// #V×#B bone weights from a #V×K distribution over the candidates `topk_index` (#V×K):
 /// out[v, topk_index[v, k]] = pred[v, k], zero elsewhere. Differentiable in `pred`.
 torch::Tensor scatter_to_bones(const torch::Tensor& pred, const torch::Tensor& topk_index,

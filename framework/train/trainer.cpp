@@ -55,6 +55,17 @@ void check_prediction(const torch::Tensor& prediction, const data::CharacterTens
   }
 }
 
+losses::LossInputs loss_inputs(const data::CharacterTensors& c, const torch::Tensor& weights) {
+  losses::LossInputs in;
+  in.pred = weights;
+  in.target = data::scatter_to_bones(c.targets, c.topk_index, c.num_bones());
+  in.laplacian = c.laplacian;
+  for (const auto& [name, prior] : c.priors) {
+    in.priors[name] = data::scatter_to_bones(prior, c.topk_index, c.num_bones());
+  }
+  return in;
+}
+
 RunDir create_run(const config::Config& config, const RunOptions& options,
                   const std::string& run_id, const std::vector<std::string>& command) {
   RunDir run = RunDir::create(options.results_dir, options.experiment, run_id);
@@ -97,11 +108,7 @@ Trainer::Trainer(const config::Config& config, World* world)
 torch::Tensor Trainer::loss_of(const data::CharacterTensors& c, const torch::Tensor& pred,
                                std::map<std::string, double>* parts) const {
   check_prediction(pred, c, options_);
-  losses::LossInputs in;
-  in.pred = data::scatter_to_bones(pred, c.topk_index, c.num_bones());
-  in.target = data::scatter_to_bones(c.targets, c.topk_index, c.num_bones());
-  in.laplacian = c.laplacian;
-  return loss_(in, parts);
+  return loss_(loss_inputs(c, data::scatter_to_bones(pred, c.topk_index, c.num_bones())), parts);
 }
 
 double Trainer::step(const std::vector<int>& indices, std::size_t step_characters,

@@ -128,4 +128,9 @@ RunDir create_run(const config::Config& config, const RunOptions& options,
 void check_prediction(const torch::Tensor& prediction, const data::CharacterTensors& c,
                       const RunOptions& options);
 
+/// What the run's losses see for `c`: the prediction `weights` (#V×#B, see
+/// data::scatter_to_bones), the targets and every prior of `c` laid out the same way, and the
+/// mesh Laplacian. Shared by training and evaluation so both score the same terms.
+losses::LossInputs loss_inputs(const data::CharacterTensors& c, const torch::Tensor& weights);
+
 }  // namespace skinlab::train

@@ -10,6 +10,7 @@
 #include "framework/losses/laplacian_smoothing.hpp"
 #include "framework/losses/loss.hpp"
 #include "framework/losses/mse.hpp"
+#include "framework/losses/prior_kl.hpp"
 #include "framework/losses/soft_cross_entropy.hpp"
 #include "tests/test_util.hpp"
 
@@ -93,6 +94,60 @@ TEST(SoftCrossEntropyLoss, EqualsKlPlusTargetEntropy) {
   expect_gradient_matches([&](const torch::Tensor& p) { return (*ce)({p, target}); }, pred);
 }
 
+TEST(PriorKlLoss, KlAgainstThePriorRenormalisedAndZeroWhereThePriorIsEmpty) {
+  const auto anchor = make("{type: prior_kl, prior: bone_heat}");
+  LossInputs in{rows({{0.5, 0.5, 0.0}, {0.2, 0.3, 0.5}})};
+  // Row 0: prior (0.3, 0.1, 0) renormalises to (0.75, 0.25, 0); row 1: no prior weight at all.
+  in.priors["bone_heat"] = rows({{0.3, 0.1, 0.0}, {0.0, 0.0, 0.0}});
+  const double row0 = 0.75 * std::log(0.75 / 0.5) + 0.25 * std::log(0.25 / 0.5);
+  EXPECT_NEAR((*anchor)(in).item<double>(), row0 / 2, 1e-12);
+  // A prediction equal to the renormalised prior costs nothing.
+  in.pred = rows({{0.75, 0.25, 0.0}, {0.2, 0.3, 0.5}});
+  EXPECT_NEAR((*anchor)(in).item<double>(), 0.0, 1e-12);
+}
+
+TEST(PriorKlLoss, NextToKlItIsKlAgainstTheMixedTarget) {
+  // kl + β prior_kl has the gradient of (1 + β) kl against (ŵ + β q) / (1 + β): the anchor pulls
+  // the optimum towards the prior by 1 / (1 + β) (prior_kl.hpp).
+  auto [pred, target] = random_distributions(12, 4);
+  torch::Tensor prior = torch::rand({12, 4}, torch::kFloat64);
+  prior.select(1, 3).zero_();  // the prior leaves a candidate at 0
+  const torch::Tensor q = prior / prior.sum(1, true);
+  const double beta = 0.5;
+  const LossSum anchored = LossSum::from(
+      config::Config::parse("losses: [{type: kl}, {type: prior_kl, prior: bone_heat, weight: 0.5}]")
+          .root()["losses"]);
+  const auto kl = make("{type: kl}");
+  const torch::Tensor mixed = (target + beta * q) / (1 + beta);
+  const auto grad = [](const std::function<torch::Tensor(const torch::Tensor&)>& f,
+                       const torch::Tensor& x) {
+    const torch::Tensor p = x.clone().set_requires_grad(true);
+    return torch::autograd::grad({f(p)}, {p})[0];
+  };
+  const torch::Tensor g_anchored = grad(
+      [&](const torch::Tensor& p) {
+        LossInputs in{p, target};
+        in.priors["bone_heat"] = prior;
+        return anchored(in);
+      },
+      pred);
+  const torch::Tensor g_mixed =
+      grad([&](const torch::Tensor& p) { return (1 + beta) * (*kl)({p, mixed}); }, pred);
+  EXPECT_TRUE(torch::allclose(g_anchored, g_mixed, 1e-9, 1e-12));
+}
+
+TEST(PriorKlLoss, Errors) {
+  const auto anchor = make("{type: prior_kl, prior: bone_heat}");
+  LossInputs in{rows({{0.5, 0.5}})};
+  expect_error<c10::Error>([&] { (*anchor)(in); },
+                           {"prior_kl: no 'bone_heat' prior", "has: none", "preprocess.priors"});
+  in.priors["geo_voxel"] = rows({{1.0, 0.0}});
+  expect_error<c10::Error>([&] { (*anchor)(in); }, {"has: geo_voxel"});
+  in.priors["bone_heat"] = rows({{1.0, 0.0, 0.0}});
+  expect_error<c10::Error>([&] { (*anchor)(in); }, {"prior shape", "prediction shape"});
+  expect_error<ConfigError>([&] { make("{type: prior_kl}"); }, {"prior"});
+}
+
 TEST(MseLoss, PerRowAndPerElement) {
   const torch::Tensor p = rows({{1, 2}, {0, 0}});
   const torch::Tensor t = rows({{0, 0}, {0, 1}});
@@ -145,7 +200,7 @@ TEST(LossSum, ConfigErrors) {
   };
   expect_error<RegistryError>([&] { build("losses: [{type: kll}]"); },
                               {"l.yaml:1: losses[0]: ", "unknown loss type 'kll'",
-                               "kl, laplacian_smoothing, mse, soft_cross_entropy"});
+                               "kl, laplacian_smoothing, mse, prior_kl, soft_cross_entropy"});
   expect_error<ConfigError>([&] { build("losses: [{type: kl, weight: -1}]"); },
                             {"losses[0].weight: must be a finite number"});
   expect_error<ConfigError>([&] { build("losses: [{type: kl, epz: 1e-6}]"); },

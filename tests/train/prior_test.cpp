@@ -143,8 +143,9 @@ TEST(Prior, AHeadOfZerosGivesThePriorRenormalisedOverTheCandidates) {
 TEST(Prior, AModelReadingAPriorTheCharacterLacksNamesBoth) {
   const auto model = make_model("prior: bone_heat, ");
   const data::CharacterTensors c = data::to_tensors(testing::prepared_tube(0), "euclidean");
-  expect_error<c10::Error>([&] { model->forward(c); },
-                           {"'tube_0'", "'bone_heat'", "preprocess.priors: [{type: bone_heat}]"});
+  expect_error<Error>([&] { model->forward(c); },
+                      {"heterskinnet: ", "'tube_0'", "'bone_heat'", "(it has: none)",
+                       "preprocess.priors: [{type: bone_heat}]"});
   expect_error<ConfigError>([&] { make_model("prior_bias: true, "); }, {"prior_bias", "prior"});
   expect_error<ConfigError>([&] { make_model("prior: bone_heat, prior_epsilon: 0, "); },
                             {"prior_epsilon", "positive"});
@@ -193,6 +194,28 @@ TEST(Prior, OnTheCandidatesIsAnEvaluatedRow) {
       {"prior"});
 }
 
+TEST(Prior, TheLossesSeeEveryPriorLaidOutAsThePrediction) {
+  const data::CharacterTensors c = data::to_tensors(tube_with_bone_heat(1), "euclidean");
+  const torch::Tensor w = data::scatter_to_bones(c.targets, c.topk_index, c.num_bones());
+  const losses::LossInputs in = train::loss_inputs(c, w);
+  ASSERT_EQ(in.priors.size(), 1u);
+  const torch::Tensor p = c.priors.at("bone_heat");
+  EXPECT_TRUE(torch::equal(in.priors.at("bone_heat"),
+                           data::scatter_to_bones(p, c.topk_index, c.num_bones())));
+  EXPECT_TRUE(torch::equal(in.target, w));
+  // prior_kl of the targets: KL(prior renormalised over the candidates ‖ targets), by hand.
+  const torch::Tensor q = p / p.sum(1, true);
+  const torch::Tensor t = c.targets.clamp_min(1e-8);
+  const double by_hand =
+      torch::where(q > 0, q * (torch::log(q.clamp_min(1e-8)) - torch::log(t)), torch::zeros_like(q))
+          .sum(1)
+          .mean()
+          .item<double>();
+  const auto anchor = loss_registry().create(
+      config::Config::parse("{type: prior_kl, prior: bone_heat}", "l.yaml").root());
+  EXPECT_NEAR((*anchor)(in).item<double>(), by_hand, 1e-5);
+}
+
 TEST(Prior, TrainsAndPredictsWithTheRunsPreparationInLibtorchAndEigen) {
   set_torch_threads(2);
   testing::TempDir dir;
@@ -204,7 +227,9 @@ TEST(Prior, TrainsAndPredictsWithTheRunsPreparationInLibtorchAndEigen) {
   const config::Config config = config::Config::parse(
       "experiment: prior\nseed: 3\nresults_dir: " + (dir / "results").string() +
       "\nmodel: " + tiny_heterskinnet("prior: bone_heat, ") +
-      "\nlosses: [{type: soft_cross_entropy, weight: 1.0}]\n"
+      // the anchor to the prior (losses/prior_kl.hpp) runs through training and validation too
+      "\nlosses: [{type: soft_cross_entropy, weight: 1.0}, {type: prior_kl, prior: bone_heat, "
+      "weight: 0.5}]\n"
       "data: {file: " + (dir / "tubes.h5").string() + ", split: random, distance: euclidean}\n"
       "train: {epochs: 2, lr: 1.0e-3, patience: 0, log_every: 0}\n");
   train::Trainer trainer(config);
