@@ -36,13 +36,13 @@ TEST(Cli, InfoListsEveryRegistry) {
   const Result r = run("info");
   ASSERT_EQ(r.status, 0) << r.err;
   for (const char* line : {"distance:", "graph_op:", "model:", "metric:", "dataset:",
-                           "loss: kl, laplacian_smoothing, mse, soft_cross_entropy", "libtorch:"}) {
+                           "loss: kl, laplacian_smoothing, mse, prior_kl, soft_cross_entropy", "libtorch:"}) {
     EXPECT_NE(r.out.find(line), std::string::npos) << line << "\n" << r.out;
   }
   const Result j = run("info --json");
   ASSERT_EQ(j.status, 0) << j.err;
   const auto info = nlohmann::json::parse(j.out);
-  EXPECT_EQ(info["registries"]["loss"].size(), 4u);
+  EXPECT_EQ(info["registries"]["loss"].size(), 5u);
   EXPECT_TRUE(info["registries"].contains("dataset"));
 }
 
@@ -73,7 +73,7 @@ TEST(Cli, UnknownTypeListsTheKnownTypes) {
   const Result r = run("config configs/heterskinnet.yaml losses.1.type=laplacian");
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("losses[1]: unknown loss type 'laplacian'; known loss types: kl, "
-                       "laplacian_smoothing, mse, soft_cross_entropy"),
+                       "laplacian_smoothing, mse, prior_kl, soft_cross_entropy"),
             std::string::npos) << r.err;
   const Result m = run("config configs/heterskinnet.yaml model.type=heterskinet");
   EXPECT_EQ(m.status, 1);

@@ -26,7 +26,7 @@ TEST(Registry, ExactKeysOfEveryCategory) {
         "v2b"}},
       {"model", {"heterskinnet", "neuroskinning", "rignet_skin"}},
       {"corrective_model", {"densegats", "neuroskinning"}},
-      {"loss", {"kl", "laplacian_smoothing", "mse", "soft_cross_entropy"}},
+      {"loss", {"kl", "laplacian_smoothing", "mse", "prior_kl", "soft_cross_entropy"}},
       {"metric", {"avg_l1", "deformation_error", "dominant_joint", "precision_recall"}},
       {"dataset", {"cube2", "folder", "nexuiz", "ogre", "openclonk", "zeroad"}},
       {"binder", {"bone_heat", "geo_voxel"}},
