@@ -456,4 +456,27 @@ Dataset read_dataset(const std::filesystem::path& file) {
   return d;
 }
 
+std::map<std::string, std::string> read_character_units(const std::filesystem::path& file,
+                                                        const std::string& per) {
+  if (per != "family" && per != "group") {
+    throw ConfigError("units of `" + file.string() + "`: unknown unit '" + per +
+                      "'; choose family or group");
+  }
+  const std::unique_ptr<H5Reader> reader = open_dataset_file(file);
+  const H5Reader& r = *reader;
+  const Checker check(r);
+  std::map<std::string, std::string> units;
+  for (const auto& name : r.read_strings("/character_names")) {
+    const std::string g = group_of(name);
+    if (!r.has(g)) check.fail(g, "character listed in /character_names has no group");
+    const std::string attribute = per == "family" ? "skeleton" : "group";
+    // A file without `group` treats every character as its own group (read_character).
+    const std::string unit = per == "group" && !r.has_attribute(g, "group")
+                                 ? name
+                                 : r.read_attribute(g, attribute);
+    units[name] = r.read_attribute(g, "source") + "/" + unit;
+  }
+  return units;
+}
+
 }  // namespace skinlab::data

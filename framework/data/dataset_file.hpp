@@ -154,4 +154,14 @@ void write_dataset(const std::filesystem::path& file, const Dataset& dataset,
 /// that are not #J×3 / #J×12, and non-finite values.
 Dataset read_dataset(const std::filesystem::path& file);
 
+/// Each character's unit of a dataset file, read from its attributes only (no arrays), for
+/// statistics over units that are independent where characters are not (`skinlab table --per`):
+/// `per` "family" gives `<source>/<skeleton>` (a skeleton family; 0 A.D.'s 34 human garments
+/// share one), "group" gives `<source>/<group>` (a variant group, clean.hpp). The source is part
+/// of the unit because family and group names are only unique within a source. Throws IoError
+/// as open_dataset_file and for a character without its group or attribute (naming both), and
+/// ConfigError for another `per`.
+std::map<std::string, std::string> read_character_units(const std::filesystem::path& file,
+                                                        const std::string& per);
+
 }  // namespace skinlab::data

@@ -147,6 +147,21 @@ void require_format(const TableOptions& options) {
   }
 }
 
+/// "character" for "characters", "skeleton family" for "skeleton families".
+std::string singular(const std::string& plural) {
+  if (plural.size() > 3 && plural.compare(plural.size() - 3, 3, "ies") == 0) {
+    return plural.substr(0, plural.size() - 3) + "y";
+  }
+  return !plural.empty() && plural.back() == 's' ? plural.substr(0, plural.size() - 1) : plural;
+}
+
+/// What units averaged over, after their count: " (each the mean over its characters; 86
+/// characters)", or nothing for plain characters.
+std::string units_note(const RunResult& run) {
+  if (run.members == 0) return "";
+  return fmt::format(" (each the mean over its characters; {} characters)", run.members);
+}
+
 /// The mark of a run made (or resumed) by a build from a modified tree.
 std::string dirty_mark(const RunResult& run) { return run.dirty ? "†" : ""; }
 
@@ -290,6 +305,32 @@ void count_as_same_data(std::vector<RunResult>& runs, const std::string& from, c
   if (renamed == 0) throw Error("table: no run was evaluated on `" + from + "` (--same-data)");
 }
 
+void average_over_units(RunResult& run, const std::map<std::string, std::string>& unit_of,
+                        const std::string& unit) {
+  std::vector<std::string> units;
+  std::vector<std::size_t> index_of(run.characters.size());
+  for (std::size_t c = 0; c < run.characters.size(); ++c) {
+    const auto at = unit_of.find(run.characters[c]);
+    if (at == unit_of.end()) {
+      throw Error("table: " + run.dir.string() + ": character '" + run.characters[c] +
+                  "' has no unit among the " + unit + " of `" + run.dataset +
+                  "` (its evaluation report's dataset)");
+    }
+    const auto found = std::find(units.begin(), units.end(), at->second);
+    index_of[c] = static_cast<std::size_t>(found - units.begin());
+    if (found == units.end()) units.push_back(at->second);
+  }
+  for (auto& [metric, values] : run.values) {
+    std::vector<std::vector<double>> members(units.size());
+    for (std::size_t c = 0; c < values.size(); ++c) members[index_of[c]].push_back(values[c]);
+    values.clear();
+    for (const auto& m : members) values.push_back(stats_of(m).mean);
+  }
+  run.members = run.characters.size();
+  run.characters = std::move(units);
+  run.unit = unit;
+}
+
 std::string make_table(const std::vector<RunResult>& runs, const TableOptions& options) {
   if (runs.empty()) throw Error("table: no runs given");
   if (options.across_splits) return make_split_table(runs, options);
@@ -362,19 +403,20 @@ std::string make_table(const std::vector<RunResult>& runs, const TableOptions& o
   }
   if (options.format == "tex") out += "\\end{table}\n";
   if (md) {
-    out += fmt::format("\n{} characters of the {} part of split '{}' of `{}`; mean ± sample "
-                       "standard deviation over characters", ref.characters.size(), ref.part,
-                       ref.split, ref.dataset);
+    out += fmt::format("\n{} {}{} of the {} part of split '{}' of `{}`; mean ± sample "
+                       "standard deviation over {}", ref.characters.size(), ref.unit,
+                       units_note(ref), ref.part, ref.split, ref.dataset, ref.unit);
     if (grouped) {
       out += "; a row of several runs (seeds) gives the mean ± sample standard deviation across "
-             "the runs of their means, and its ANOVA uses each character's mean over the runs";
+             "the runs of their means, and its ANOVA uses each " + singular(ref.unit) +
+             "'s mean over the runs";
     }
     out += ".\n";
     if (rows.size() > 1 && ref.characters.size() > 1) {
       out += "The one-way ANOVA (the paper's test, Sec. 4.5) treats the two rows' values as "
-             "independent samples; the paired t-test uses each character's difference (row − " +
-             name(rows.front()) + ", t > 0 where the row is larger), as both rows score the same "
-             "characters; p is two-sided.\n";
+             "independent samples; the paired t-test uses each " + singular(ref.unit) +
+             "'s difference (row − " + name(rows.front()) + ", t > 0 where the row is larger), as "
+             "both rows score the same " + ref.unit + "; p is two-sided.\n";
     }
     if (std::any_of(rows.begin(), rows.end(), [](const Row& r) { return r.any_dirty(); })) out += kDirtyNote;
     out += definitions_text(ref);
@@ -513,14 +555,19 @@ std::string make_split_table(const std::vector<RunResult>& runs, const TableOpti
   }
   if (options.format == "tex") out += "\\end{table}\n";
   if (md) {
-    out += "\nMean over each test set's characters";
-    if (options.group_runs) out += " (a method with several runs, e.g. seeds: of each character's mean over its runs)";
+    const std::string& unit = runs.front().unit;
+    out += "\nMean over each test set's " + unit;
+    if (options.group_runs) {
+      out += " (a method with several runs, e.g. seeds: of each " + singular(unit) +
+             "'s mean over its runs)";
+    }
     out += "; (p …; paired …): two-sided p of the one-way ANOVA (the paper's test, Sec. 4.5) and "
-           "of the paired t-test over the same characters against " + reference + ". Test sets: ";
+           "of the paired t-test over the same " + unit + " against " + reference + ". Test sets: ";
     for (std::size_t col = 0; col < columns.size(); ++col) {
       const RunResult& r = *column_ref[col];
-      out += fmt::format("{}{}: {} characters, {} part of split '{}' of `{}`", col ? "; " : "",
-                         columns[col].name, r.characters.size(), r.part, r.split, r.dataset);
+      out += fmt::format("{}{}: {} {}{}, {} part of split '{}' of `{}`", col ? "; " : "",
+                         columns[col].name, r.characters.size(), r.unit, units_note(r), r.part,
+                         r.split, r.dataset);
     }
     out += ".\n";
     if (std::any_of(runs.begin(), runs.end(), [](const RunResult& r) { return r.dirty; })) out += kDirtyNote;

@@ -39,6 +39,11 @@ struct RunResult {
   /// The run's env.json says a build from a modified tree made or resumed it (`git_dirty`, or a
   /// resume's); tables mark it with †. False without an env.json.
   bool dirty = false;
+  /// What an entry of `characters` is (plural, for the note under a table): "characters", or
+  /// after average_over_units the unit, e.g. "skeleton families".
+  std::string unit = "characters";
+  /// The characters averaged into those units (0 when not averaged).
+  std::size_t members = 0;
 };
 
 /// Reads `<dir>/eval_<part>.json`, the `metrics` section of `<dir>/config.yaml` and the git state
@@ -67,6 +72,16 @@ struct TableOptions {
 /// characters, so its runs share the columns of the other file's runs; the table still checks
 /// the characters. Throws Error when no run was evaluated on `from`.
 void count_as_same_data(std::vector<RunResult>& runs, const std::string& from, const std::string& to);
+
+/// Makes a run's entries units of several characters (`skinlab table --per family|group`):
+/// each unit's value of a metric is the mean over its characters where the metric is defined
+/// (NaN when it is nowhere), units in order of their first character. The tests then count
+/// units, not characters: 0 A.D.'s 34 human garment variants share one skeleton and one artist's
+/// conventions, so as 34 characters they would weigh as 34 independent samples. `unit_of` maps
+/// a character to its unit (data::read_character_units), `unit` names the units in the plural.
+/// Throws Error naming the run and the character when a character has no unit.
+void average_over_units(RunResult& run, const std::map<std::string, std::string>& unit_of,
+                        const std::string& unit);
 
 /// The table text (see the file comment). Throws Error for fewer than one run, an unknown
 /// format, a metric missing from a run (naming both), or runs on different characters.

@@ -267,6 +267,16 @@ void check_smoke_table3(const TempDir& dir, const std::string& data, const std::
   EXPECT_EQ(std::adjacent_find(avg_l1.begin(), avg_l1.end()), avg_l1.end());
   EXPECT_NE(table.find("| One-way ANOVA vs smoke |"), std::string::npos) << table;
   EXPECT_NE(table.find("| bone_heat_smoke | "), std::string::npos) << table;
+  // The same runs per skeleton family, read from the dataset file they were evaluated on.
+  const std::string runs = results + "/smoke/smoke_table3 " + results + "/bone_heat_smoke/smoke_table3";
+  const Result families = run("table " + runs + " --per family");
+  ASSERT_EQ(families.status, 0) << families.err;
+  EXPECT_NE(families.out.find("(each the mean over its characters; 3 characters) of the test part"),
+            std::string::npos)
+      << families.out;
+  const Result unknown = run("table " + runs + " --per source");
+  EXPECT_NE(unknown.status, 0);
+  EXPECT_NE(unknown.err.find("--per"), std::string::npos) << unknown.err;
 }
 
 TEST(Cli, SmokeRunPrepareTrainEvalOnTheBundledSubset) {

@@ -63,6 +63,27 @@ TEST(DatasetFile, RoundTrip) {
   EXPECT_EQ(r.excluded[1].reason, "no bones");
 }
 
+TEST(DatasetFile, CharacterUnitsAreSourceAndSkeletonFamilyOrVariantGroup) {
+  TempDir dir;
+  data::Dataset d = tiny_dataset();
+  d.characters[0].source = "zeroad";
+  d.characters[0].skeleton = "Biped";
+  d.characters[0].group = "";  // written as its own name
+  d.characters[1].source = "ogre";
+  d.characters[1].skeleton = "Biped";
+  d.characters[1].group = "alpha";
+  data::write_dataset(dir / "u.h5", d);
+  using Units = std::map<std::string, std::string>;
+  // the same family name in two sources is two families
+  EXPECT_EQ(data::read_character_units(dir / "u.h5", "family"),
+            (Units{{"alpha", "zeroad/Biped"}, {"beta", "ogre/Biped"}}));
+  EXPECT_EQ(data::read_character_units(dir / "u.h5", "group"),
+            (Units{{"alpha", "zeroad/alpha"}, {"beta", "ogre/alpha"}}));
+  expect_error<ConfigError>([&] { data::read_character_units(dir / "u.h5", "source"); },
+                            {"u.h5", "unknown unit 'source'", "family or group"});
+  expect_error<IoError>([&] { data::read_character_units(dir / "none.h5", "family"); }, {"none.h5"});
+}
+
 /// What an older skinlab wrote: format_version `version`, a variable-length string attribute and
 /// a variable-length string list (their data in HDF5's global heap).
 void write_variable_length_file(const std::filesystem::path& file, std::int64_t version) {

@@ -3,10 +3,12 @@
 // 1 − t/√(t² + 2) with t = √F; the paired t of two differences has one degree of freedom, whose
 // two-sided p is 1 − (2/π)·atan|t|), the thresholds quoted from the run config, CSV and LaTeX, and
 // the errors for runs on different characters, a missing metric and a missing evaluation; runs
-// of one experiment grouped into one row (seeds); the generalisation table across test sets.
+// of one experiment grouped into one row (seeds); characters averaged into units (skeleton
+// families) before the tests; the generalisation table across test sets.
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <nlohmann/json.hpp>
 
 #include "framework/core/error.hpp"
@@ -146,6 +148,43 @@ TEST(Table, GroupedRunsGiveMeanAndSdAcrossRunsAndAnovaOnCharacterMeans) {
   o.group_runs = false;
   const std::string rows = report::make_table({s0, other, s1}, o);
   EXPECT_NE(rows.find("| ours (s1) | "), std::string::npos) << rows;
+}
+
+TEST(Table, PerUnitTheTestsCountUnitsEachTheMeanOfItsCharacters) {
+  const TempDir dir;
+  // a and b are one family (say 0 A.D.'s garments), c and d one each; d's recall is undefined
+  const std::vector<std::string> characters{"a", "b", "c", "d"};
+  const double nan = std::nan("");
+  auto ours = report::load_run_result(
+      saved_run(dir, "ours", characters, {{"precision", {0.8, 0.6, 0.5, 0.9}}, {"recall", {0.5, 0.7, 0.6, nan}}}),
+      "test");
+  auto other = report::load_run_result(
+      saved_run(dir, "other", characters, {{"precision", {0.4, 0.4, 0.3, 0.8}}, {"recall", {0.5, 0.5, 0.4, nan}}}),
+      "test");
+  const std::map<std::string, std::string> family{{"a", "s/F"}, {"b", "s/F"}, {"c", "s/G"}, {"d", "t/H"}};
+  report::average_over_units(ours, family, "skeleton families");
+  report::average_over_units(other, family, "skeleton families");
+  EXPECT_EQ(ours.characters, (std::vector<std::string>{"s/F", "s/G", "t/H"}));
+  EXPECT_EQ(ours.members, 4u);
+  EXPECT_DOUBLE_EQ(ours.values.at("precision")[0], 0.7);
+  EXPECT_DOUBLE_EQ(ours.values.at("precision")[1], 0.5);
+  EXPECT_DOUBLE_EQ(ours.values.at("recall")[0], 0.6);
+  EXPECT_TRUE(std::isnan(ours.values.at("recall")[2]));
+  report::TableOptions o;
+  o.metrics = {"precision"};
+  const std::string md = report::make_table({ours, other}, o);
+  // unit means (0.7, 0.5, 0.9) against (0.4, 0.3, 0.8): differences −0.3, −0.2, −0.1, mean −0.2,
+  // sd 0.1, t = −0.2 / (0.1/√3) = −2√3 with 2 degrees of freedom: p = 1 − |t|/√(t² + 2) = 0.0742
+  EXPECT_NE(md.find("| ours | r1 | 70.00% ± 20.00% |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| other | -3.4641 (0.0742) |"), std::string::npos) << md;
+  EXPECT_NE(md.find("3 skeleton families (each the mean over its characters; 4 characters) of "
+                    "the test part"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("each skeleton family's difference"), std::string::npos) << md;
+  auto stranger = report::load_run_result(saved_run(dir, "stranger", {"a", "z"}, {{"precision", {0.1, 0.2}}}), "test");
+  testing::expect_error<Error>([&] { report::average_over_units(stranger, family, "skeleton families"); },
+                               {"stranger", "character 'z' has no unit", "`d.h5`"});
 }
 
 TEST(Table, RunsFromAModifiedTreeAreMarked) {
