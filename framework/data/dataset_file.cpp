@@ -465,15 +465,14 @@ std::map<std::string, std::string> read_character_units(const std::filesystem::p
   const std::unique_ptr<H5Reader> reader = open_dataset_file(file);
   const H5Reader& r = *reader;
   const Checker check(r);
+  const std::string attribute = per == "family" ? "skeleton" : "group";
   std::map<std::string, std::string> units;
   for (const auto& name : r.read_strings("/character_names")) {
     const std::string g = group_of(name);
     if (!r.has(g)) check.fail(g, "character listed in /character_names has no group");
-    const std::string attribute = per == "family" ? "skeleton" : "group";
     // A file without `group` treats every character as its own group (read_character).
-    const std::string unit = per == "group" && !r.has_attribute(g, "group")
-                                 ? name
-                                 : r.read_attribute(g, attribute);
+    const std::string unit =
+        per == "group" && !r.has_attribute(g, "group") ? name : r.read_attribute(g, attribute);
     units[name] = r.read_attribute(g, "source") + "/" + unit;
   }
   return units;

@@ -1,5 +1,6 @@
 #include "framework/losses/loss.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "framework/core/registry.hpp"
@@ -45,6 +46,16 @@ torch::Tensor LossSum::operator()(const LossInputs& in, std::map<std::string, do
     total = total.defined() ? total + value : value;
   }
   return total;
+}
+
+std::vector<std::string> LossSum::priors() const {
+  std::vector<std::string> names;
+  for (const auto& term : terms_) {
+    for (std::string& name : term.loss->priors()) names.push_back(std::move(name));
+  }
+  std::sort(names.begin(), names.end());
+  names.erase(std::unique(names.begin(), names.end()), names.end());
+  return names;
 }
 
 }  // namespace skinlab::losses

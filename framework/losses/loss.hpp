@@ -40,6 +40,9 @@ class Loss {
   virtual ~Loss() = default;
   /// A 0-dim tensor, differentiable with respect to `in.pred`.
   virtual torch::Tensor operator()(const LossInputs& in) const = 0;
+  /// The names of the priors this loss reads from `LossInputs::priors`; the trainer lays out
+  /// only those (train::loss_inputs), so a loss that reads one must name it here.
+  virtual std::vector<std::string> priors() const { return {}; }
 };
 
 /// Throws std::invalid_argument (via TORCH_CHECK) unless `pred` and `target` are defined,
@@ -56,6 +59,9 @@ class LossSum {
   /// Total loss. When `parts` is given it receives each term's (unweighted) value by type; a
   /// type listed twice is reported as `type`, `type#2`, ...
   torch::Tensor operator()(const LossInputs& in, std::map<std::string, double>* parts = nullptr) const;
+
+  /// The priors any term reads (Loss::priors), each once, sorted.
+  std::vector<std::string> priors() const;
 
   struct Term {
     std::string name;

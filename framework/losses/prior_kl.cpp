@@ -1,6 +1,7 @@
 #include "framework/losses/prior_kl.hpp"
 
 #include "framework/core/registry.hpp"
+#include "framework/core/text.hpp"
 #include "framework/losses/kl.hpp"
 
 namespace skinlab::losses {
@@ -18,13 +19,9 @@ torch::Tensor PriorKlLoss::operator()(const LossInputs& in) const {
   TORCH_CHECK(in.pred.defined() && in.pred.dim() == 2,
               "prior_kl: needs a #V×C prediction");
   const auto it = in.priors.find(options_.prior);
-  if (it == in.priors.end()) {
-    std::string have;
-    for (const auto& [key, p] : in.priors) have += (have.empty() ? "" : ", ") + key;
-    TORCH_CHECK(false, "prior_kl: no '", options_.prior, "' prior to anchor to (the character has: ",
-                have.empty() ? "none" : have, "); prepare the dataset with preprocess.priors: [{type: ",
-                options_.prior, "}]");
-  }
+  TORCH_CHECK(it != in.priors.end(), "prior_kl: no '", options_.prior,
+              "' prior to anchor to (the character has: ", joined_keys(in.priors),
+              "); prepare the dataset with preprocess.priors: [{type: ", options_.prior, "}]");
   const torch::Tensor& p = it->second;
   TORCH_CHECK(p.sizes() == in.pred.sizes(), "prior_kl: prior shape ", p.sizes(),
               " differs from prediction shape ", in.pred.sizes());

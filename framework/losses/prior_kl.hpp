@@ -21,6 +21,7 @@
 /// Result: mean over vertices, like every loss (loss.hpp).
 
 #include <string>
+#include <vector>
 
 #include "framework/losses/loss.hpp"
 
@@ -35,6 +36,7 @@ class PriorKlLoss final : public Loss {
   };
   explicit PriorKlLoss(Options options) : options_(std::move(options)) {}
   torch::Tensor operator()(const LossInputs& in) const override;
+  std::vector<std::string> priors() const override { return {options_.prior}; }
 
  private:
   Options options_;

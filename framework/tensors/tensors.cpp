@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "framework/core/error.hpp"
+#include "framework/core/text.hpp"
 #include "framework/data/preprocess.hpp"
 #include "framework/geometry/orient_outward.hpp"
 #include "framework/geometry/vertex_normals.hpp"
@@ -31,10 +32,8 @@ torch::Tensor to_long(const RowMatrixXi& m) {
 CharacterTensors to_tensors(const PreparedCharacter& character, const std::string& distance) {
   const auto it = character.distances.find(distance);
   if (it == character.distances.end()) {
-    std::string have;
-    for (const auto& [key, d] : character.distances) have += (have.empty() ? "" : ", ") + key;
     throw IoError("character '" + character.name + "' has no distance type '" + distance +
-                  "'; it was prepared with: " + (have.empty() ? "(none)" : have));
+                  "'; it was prepared with: " + joined_keys(character.distances, "(none)"));
   }
   const DistanceData& d = it->second;
   const auto nv = static_cast<Eigen::Index>(character.num_vertices());
@@ -109,11 +108,10 @@ const torch::Tensor& prior_of(const CharacterTensors& c, const std::string& name
                               const std::string& who) {
   const auto it = c.priors.find(name);
   if (it == c.priors.end()) {
-    std::string have;
-    for (const auto& [key, p] : c.priors) have += (have.empty() ? "" : ", ") + key;
-    throw Error(fmt::format("{}: character '{}' has no '{}' prior (it has: {}); prepare its dataset "
-                            "with preprocess.priors: [{{type: {}}}]",
-                            who, c.name, name, have.empty() ? "none" : have, name));
+    throw Error(
+        fmt::format("{}: character '{}' has no '{}' prior (it has: {}); prepare its dataset "
+                    "with preprocess.priors: [{{type: {}}}]",
+                    who, c.name, name, joined_keys(c.priors), name));
   }
   return it->second;
 }

@@ -1,6 +1,7 @@
 #include "framework/train/run_data.hpp"
 
 #include "framework/core/error.hpp"
+#include "framework/core/text.hpp"
 
 namespace skinlab::train {
 
@@ -19,10 +20,9 @@ data::Dataset read(const DataOptions& options) {
 RunData::RunData(const DataOptions& options) : options_(options), dataset_(read(options)) {
   const auto it = dataset_.splits.find(options.split);
   if (it == dataset_.splits.end()) {
-    std::string have;
-    for (const auto& [name, split] : dataset_.splits) have += (have.empty() ? "" : ", ") + name;
-    throw IoError(options.file + ": no split '" + options.split + "' (data.split); the file has " +
-                  (have.empty() ? "no splits" : "the splits: " + have));
+    throw IoError(
+        options.file + ": no split '" + options.split + "' (data.split); the file has " +
+        (dataset_.splits.empty() ? "no splits" : "the splits: " + joined_keys(dataset_.splits)));
   }
   split_ = it->second;
 }

@@ -55,13 +55,15 @@ void check_prediction(const torch::Tensor& prediction, const data::CharacterTens
   }
 }
 
-losses::LossInputs loss_inputs(const data::CharacterTensors& c, const torch::Tensor& weights) {
+losses::LossInputs loss_inputs(const data::CharacterTensors& c, const torch::Tensor& weights,
+                               const std::vector<std::string>& priors) {
   losses::LossInputs in;
   in.pred = weights;
   in.target = data::scatter_to_bones(c.targets, c.topk_index, c.num_bones());
   in.laplacian = c.laplacian;
-  for (const auto& [name, prior] : c.priors) {
-    in.priors[name] = data::scatter_to_bones(prior, c.topk_index, c.num_bones());
+  for (const std::string& name : priors) {
+    in.priors[name] =
+        data::scatter_to_bones(data::prior_of(c, name, "losses"), c.topk_index, c.num_bones());
   }
   return in;
 }
@@ -90,6 +92,7 @@ Trainer::Trainer(const config::Config& config, World* world)
   check_checkpointable(*model_);
   initial_torch_rng_ = get_rng_state(at::detail::getDefaultCPUGenerator());
   loss_ = losses::LossSum::from(options_.losses);
+  priors_ = loss_.priors();
   const auto parameters = model_->parameters();
   if (parameters.empty()) {
     options_.model.fail("model '" + options_.model["type"].as<std::string>() +
@@ -108,7 +111,8 @@ Trainer::Trainer(const config::Config& config, World* world)
 torch::Tensor Trainer::loss_of(const data::CharacterTensors& c, const torch::Tensor& pred,
                                std::map<std::string, double>* parts) const {
   check_prediction(pred, c, options_);
-  return loss_(loss_inputs(c, data::scatter_to_bones(pred, c.topk_index, c.num_bones())), parts);
+  return loss_(loss_inputs(c, data::scatter_to_bones(pred, c.topk_index, c.num_bones()), priors_),
+               parts);
 }
 
 double Trainer::step(const std::vector<int>& indices, std::size_t step_characters,

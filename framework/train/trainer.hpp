@@ -114,6 +114,7 @@ class Trainer {
   std::unique_ptr<World> alone_;  ///< the world of one when none is given
   std::shared_ptr<models::Model> model_;
   losses::LossSum loss_;
+  std::vector<std::string> priors_;  ///< loss_.priors(): the priors loss_inputs lays out
   std::unique_ptr<torch::optim::Adam> optimizer_;
   torch::Tensor initial_torch_rng_;  ///< libtorch's generator right after the model was built
   bool fitted_ = false;
@@ -129,8 +130,11 @@ void check_prediction(const torch::Tensor& prediction, const data::CharacterTens
                       const RunOptions& options);
 
 /// What the run's losses see for `c`: the prediction `weights` (#V×#B, see
-/// data::scatter_to_bones), the targets and every prior of `c` laid out the same way, and the
-/// mesh Laplacian. Shared by training and evaluation so both score the same terms.
-losses::LossInputs loss_inputs(const data::CharacterTensors& c, const torch::Tensor& weights);
+/// data::scatter_to_bones), the targets and the named `priors` of `c` laid out the same way
+/// (the losses' LossSum::priors; only those, as the layout costs a #V×#B tensor each), and the
+/// mesh Laplacian. Shared by training and evaluation so both score the same terms. Throws Error
+/// naming the character when it lacks one of `priors` (data::prior_of).
+losses::LossInputs loss_inputs(const data::CharacterTensors& c, const torch::Tensor& weights,
+                               const std::vector<std::string>& priors);
 
 }  // namespace skinlab::train

@@ -148,6 +148,16 @@ TEST(PriorKlLoss, Errors) {
   expect_error<ConfigError>([&] { make("{type: prior_kl}"); }, {"prior"});
 }
 
+TEST(LossSum, NamesThePriorsItsTermsReadOnceEach) {
+  const auto sum = [](const std::string& list) {
+    return LossSum::from(config::Config::parse("losses: " + list).root()["losses"]).priors();
+  };
+  EXPECT_TRUE(sum("[{type: kl}, {type: laplacian_smoothing}]").empty());
+  EXPECT_EQ(sum("[{type: prior_kl, prior: geo_voxel}, {type: kl}, {type: prior_kl, prior: "
+                "bone_heat}, {type: prior_kl, prior: geo_voxel, weight: 2}]"),
+            (std::vector<std::string>{"bone_heat", "geo_voxel"}));
+}
+
 TEST(MseLoss, PerRowAndPerElement) {
   const torch::Tensor p = rows({{1, 2}, {0, 0}});
   const torch::Tensor t = rows({{0, 0}, {0, 1}});

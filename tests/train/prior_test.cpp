@@ -194,10 +194,14 @@ TEST(Prior, OnTheCandidatesIsAnEvaluatedRow) {
       {"prior"});
 }
 
-TEST(Prior, TheLossesSeeEveryPriorLaidOutAsThePrediction) {
+TEST(Prior, TheLossesSeeTheirPriorsLaidOutAsThePrediction) {
   const data::CharacterTensors c = data::to_tensors(tube_with_bone_heat(1), "euclidean");
   const torch::Tensor w = data::scatter_to_bones(c.targets, c.topk_index, c.num_bones());
-  const losses::LossInputs in = train::loss_inputs(c, w);
+  // Only the priors the losses name are laid out; one the character lacks names it.
+  EXPECT_TRUE(train::loss_inputs(c, w, {}).priors.empty());
+  expect_error<Error>([&] { train::loss_inputs(c, w, {"geo_voxel"}); },
+                      {"losses", c.name, "no 'geo_voxel' prior", "it has: bone_heat"});
+  const losses::LossInputs in = train::loss_inputs(c, w, {"bone_heat"});
   ASSERT_EQ(in.priors.size(), 1u);
   const torch::Tensor p = c.priors.at("bone_heat");
   EXPECT_TRUE(torch::equal(in.priors.at("bone_heat"),

@@ -1,0 +1,20 @@
+#pragma once
+/// \file
+/// Small text helpers for error messages that list what exists (the distances a character was
+/// prepared with, the splits of a dataset file, the priors of a character).
+
+#include <string>
+#include <string_view>
+
+namespace skinlab {
+
+/// The keys of an associative container, in its order, joined with ", "; `none` when it is
+/// empty.
+template <class Map>
+std::string joined_keys(const Map& map, std::string_view none = "none") {
+  std::string out;
+  for (const auto& entry : map) out += (out.empty() ? "" : ", ") + std::string(entry.first);
+  return out.empty() ? std::string(none) : out;
+}
+
+}  // namespace skinlab
