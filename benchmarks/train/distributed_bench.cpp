@@ -4,8 +4,8 @@
 // of 2 characters per step. The time is the epochs' own (metrics.jsonl `seconds`: steps and
 // validation), not process start-up or data loading; reported per epoch.
 //
-//   build/benchmarks/distributed_bench --benchmark_out=results/benchmarks/distributed_bench.json \
-//       --benchmark_out_format=json
+//   build/benchmarks/distributed_bench --benchmark_out_format=json
+//       --benchmark_out=results/benchmarks/distributed_bench.json   (one command line)
 
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>

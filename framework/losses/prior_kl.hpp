@@ -16,8 +16,8 @@
 /// others. With weight β next to the data term `kl`, the per-vertex optimum is the mixture
 /// (ŵ + β q) / (1 + β) (the gradient of Σ kl + β L_P is that of `kl` against the mixed target),
 /// i.e. a correction shrunk towards the prior by 1 / (1 + β) where the data is ambiguous.
-/// Measured with β = 0.5 on that split (two seeds each): L1 0.670 against 0.711 unanchored and
-/// 0.693 for bone heat (results/tables/prior_anchor_zeroad.md).
+/// Measured with β = 0.5 on that split (three seeds; the unanchored model two): L1 0.669 against
+/// 0.711 unanchored and 0.693 for bone heat (results/tables/prior_anchor_zeroad.md).
 /// Result: mean over vertices, like every loss (loss.hpp).
 
 #include <string>
