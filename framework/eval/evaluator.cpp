@@ -150,7 +150,6 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
   std::string method_type, prior_type;
   std::int64_t epoch = 0;
   std::unique_ptr<losses::LossSum> loss;
-  std::vector<std::string> loss_priors;  // the priors the losses read (LossSum::priors)
   if (is_binder) {
     method_type = o.binder.required_type("binder");
     if (binders::is_reference_row(method_type)) {
@@ -162,7 +161,6 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
     model = train::build_model(o);
     epoch = train::load_checkpoint(checkpoint, *model).epoch;
     loss = std::make_unique<losses::LossSum>(losses::LossSum::from(o.losses));
-    loss_priors = loss->priors();
     model->eval();
   }
   std::vector<std::shared_ptr<Metric>> metrics;
@@ -226,7 +224,7 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
     r.vertices = static_cast<int>(c.num_vertices());
     r.bones = static_cast<int>(c.num_bones());
     if (loss) {
-      r.values["loss"] = (*loss)(train::loss_inputs(c, weights, loss_priors)).item<double>();
+      r.values["loss"] = (*loss)(train::loss_inputs(c, weights, loss->priors())).item<double>();
     }
     MetricInputs mi;
     mi.pred = weights;

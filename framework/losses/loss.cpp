@@ -33,7 +33,12 @@ LossSum LossSum::from(const config::Node& list) {
     const int n = ++seen[type];
     sum.terms_.push_back(Term{n == 1 ? type : type + "#" + std::to_string(n), weight,
                               loss_registry().create(type, entry)});
+    for (std::string& prior : sum.terms_.back().loss->priors()) {
+      sum.priors_.push_back(std::move(prior));
+    }
   }
+  std::sort(sum.priors_.begin(), sum.priors_.end());
+  sum.priors_.erase(std::unique(sum.priors_.begin(), sum.priors_.end()), sum.priors_.end());
   return sum;
 }
 
@@ -46,16 +51,6 @@ torch::Tensor LossSum::operator()(const LossInputs& in, std::map<std::string, do
     total = total.defined() ? total + value : value;
   }
   return total;
-}
-
-std::vector<std::string> LossSum::priors() const {
-  std::vector<std::string> names;
-  for (const auto& term : terms_) {
-    for (std::string& name : term.loss->priors()) names.push_back(std::move(name));
-  }
-  std::sort(names.begin(), names.end());
-  names.erase(std::unique(names.begin(), names.end()), names.end());
-  return names;
 }
 
 }  // namespace skinlab::losses

@@ -60,8 +60,8 @@ class LossSum {
   /// type listed twice is reported as `type`, `type#2`, ...
   torch::Tensor operator()(const LossInputs& in, std::map<std::string, double>* parts = nullptr) const;
 
-  /// The priors any term reads (Loss::priors), each once, sorted.
-  std::vector<std::string> priors() const;
+  /// The priors any term reads (Loss::priors), each once, sorted; collected by `from`.
+  const std::vector<std::string>& priors() const { return priors_; }
 
   struct Term {
     std::string name;
@@ -72,6 +72,7 @@ class LossSum {
 
  private:
   std::vector<Term> terms_;
+  std::vector<std::string> priors_;
 };
 
 }  // namespace skinlab::losses

@@ -92,7 +92,6 @@ Trainer::Trainer(const config::Config& config, World* world)
   check_checkpointable(*model_);
   initial_torch_rng_ = get_rng_state(at::detail::getDefaultCPUGenerator());
   loss_ = losses::LossSum::from(options_.losses);
-  priors_ = loss_.priors();
   const auto parameters = model_->parameters();
   if (parameters.empty()) {
     options_.model.fail("model '" + options_.model["type"].as<std::string>() +
@@ -111,8 +110,8 @@ Trainer::Trainer(const config::Config& config, World* world)
 torch::Tensor Trainer::loss_of(const data::CharacterTensors& c, const torch::Tensor& pred,
                                std::map<std::string, double>* parts) const {
   check_prediction(pred, c, options_);
-  return loss_(loss_inputs(c, data::scatter_to_bones(pred, c.topk_index, c.num_bones()), priors_),
-               parts);
+  const torch::Tensor weights = data::scatter_to_bones(pred, c.topk_index, c.num_bones());
+  return loss_(loss_inputs(c, weights, loss_.priors()), parts);
 }
 
 double Trainer::step(const std::vector<int>& indices, std::size_t step_characters,

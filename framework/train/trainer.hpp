@@ -114,7 +114,6 @@ class Trainer {
   std::unique_ptr<World> alone_;  ///< the world of one when none is given
   std::shared_ptr<models::Model> model_;
   losses::LossSum loss_;
-  std::vector<std::string> priors_;  ///< loss_.priors(): the priors loss_inputs lays out
   std::unique_ptr<torch::optim::Adam> optimizer_;
   torch::Tensor initial_torch_rng_;  ///< libtorch's generator right after the model was built
   bool fitted_ = false;
