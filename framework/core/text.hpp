@@ -1,7 +1,8 @@
 #pragma once
 /// \file
 /// Small text helpers for error messages that list what exists (the distances a character was
-/// prepared with, the splits of a dataset file, the priors of a character).
+/// prepared with, the splits of a dataset file, the priors of a character, the sources of a
+/// split).
 
 #include <string>
 #include <string_view>
@@ -14,6 +15,15 @@ template <class Map>
 std::string joined_keys(const Map& map, std::string_view none = "none") {
   std::string out;
   for (const auto& entry : map) out += (out.empty() ? "" : ", ") + std::string(entry.first);
+  return out.empty() ? std::string(none) : out;
+}
+
+/// The elements of a container of strings, in its order, joined with ", "; `none` when it is
+/// empty.
+template <class Container>
+std::string joined(const Container& values, std::string_view none = "none") {
+  std::string out;
+  for (const auto& value : values) out += (out.empty() ? "" : ", ") + std::string(value);
   return out.empty() ? std::string(none) : out;
 }
 

@@ -6,6 +6,7 @@
 #include <set>
 
 #include "framework/core/error.hpp"
+#include "framework/core/text.hpp"
 
 namespace skinlab::data {
 
@@ -123,9 +124,7 @@ std::map<std::string, Split> make_splits(const std::vector<std::string>& groups,
                                   const std::string& kind) {
     const std::set<std::string> present(values.begin(), values.end());
     if (present.count(value)) return;
-    std::string list;
-    for (const auto& p : present) list += (list.empty() ? "" : ", ") + p;
-    throw Error(what + " '" + value + "'; " + kind + " present: " + list);
+    throw Error(what + " '" + value + "'; " + kind + " present: " + joined(present));
   };
 
   if (!options.heldout_skeletons.empty()) {
@@ -156,6 +155,49 @@ std::map<std::string, Split> make_splits(const std::vector<std::string>& groups,
     std::vector<bool> held(static_cast<std::size_t>(n));
     for (int i = 0; i < n; ++i) held[i] = test_groups.count(groups[static_cast<std::size_t>(i)]) > 0;
     out["leave_out_" + name] = hold_out(held, options.seed + offset++, what);
+  }
+  return out;
+}
+
+Split validate_on_sources(const Split& split, const std::vector<std::string>& groups,
+                          const std::vector<std::string>& sources,
+                          const std::vector<bool>& augmented,
+                          const std::vector<std::string>& val_sources, const std::string& what) {
+  if (groups.size() != sources.size() || groups.size() != augmented.size()) {
+    throw Error("validate_on_sources: " + std::to_string(groups.size()) + " groups but " +
+                std::to_string(sources.size()) + " sources and " +
+                std::to_string(augmented.size()) + " augmentation flags");
+  }
+  std::vector<int> pool(split.train);
+  pool.insert(pool.end(), split.val.begin(), split.val.end());
+  std::sort(pool.begin(), pool.end());
+  std::set<std::string> present;
+  for (int i : pool) present.insert(sources.at(static_cast<std::size_t>(i)));
+  const std::set<std::string> chosen(val_sources.begin(), val_sources.end());
+  for (const auto& source : chosen) {
+    if (present.count(source)) continue;
+    throw Error(what + ": no training or validation character comes from source '" + source +
+                "'; sources there: " + joined(present));
+  }
+  std::set<std::string> val_groups;
+  for (int i : pool) {
+    if (chosen.count(sources[static_cast<std::size_t>(i)])) {
+      val_groups.insert(groups[static_cast<std::size_t>(i)]);
+    }
+  }
+  Split out;
+  out.test = split.test;
+  for (int i : pool) {
+    const auto k = static_cast<std::size_t>(i);
+    if (!val_groups.count(groups[k])) {
+      out.train.push_back(i);
+    } else if (!augmented[k]) {
+      out.val.push_back(i);
+    }
+  }
+  if (std::none_of(out.train.begin(), out.train.end(),
+                   [&](int i) { return !augmented[static_cast<std::size_t>(i)]; })) {
+    throw Error(what + ": validating on these sources leaves nothing to train on");
   }
   return out;
 }

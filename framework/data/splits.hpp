@@ -18,6 +18,10 @@
 ///   trains. It measures generalisation to a game never seen in training, the project's proxy
 ///   for a user's own character.
 ///
+/// A run can also judge its training on sources it never trains on: validate_on_sources (the
+/// `data.val_sources` of a run config) moves the variant groups of chosen sources from a split's
+/// train and val parts into a new val part, without preparing the file again.
+///
 /// The shuffle is our own Fisher–Yates over std::mt19937_64 with an explicit integer draw, so a
 /// seed gives the same splits with every standard library.
 
@@ -50,5 +54,18 @@ std::map<std::string, Split> make_splits(const std::vector<std::string>& groups,
                                          const std::vector<std::string>& skeletons,
                                          const std::vector<std::string>& sources,
                                          const SplitOptions& options);
+
+/// `split` with its validation part drawn from sources instead of at random: every character of
+/// its train and val parts whose variant group (`groups`, parallel to `sources` and `augmented`)
+/// has a member from one of `val_sources` validates, the rest of both parts trains, and augmented
+/// copies (`augmented[i]`) of validating characters are dropped (a copy only ever trains). The
+/// test part is unchanged. With a leave-one-source-out split this makes early stopping and model
+/// choices (such as prior_kl's β) look at a game the model never trained on, as the test does.
+/// Throws Error, starting with `what`, when a source has no character in the train and val parts
+/// (listing the sources they have) or when nothing would be left to train on.
+Split validate_on_sources(const Split& split, const std::vector<std::string>& groups,
+                          const std::vector<std::string>& sources,
+                          const std::vector<bool>& augmented,
+                          const std::vector<std::string>& val_sources, const std::string& what);
 
 }  // namespace skinlab::data

@@ -2,6 +2,7 @@
 
 #include "framework/core/error.hpp"
 #include "framework/core/text.hpp"
+#include "framework/data/splits.hpp"
 
 namespace skinlab::train {
 
@@ -25,6 +26,23 @@ RunData::RunData(const DataOptions& options) : options_(options), dataset_(read(
         (dataset_.splits.empty() ? "no splits" : "the splits: " + joined_keys(dataset_.splits)));
   }
   split_ = it->second;
+  if (options.val_sources.empty()) return;
+  const std::size_t n = dataset_.characters.size();
+  std::vector<std::string> groups(n), sources(n);
+  std::vector<bool> augmented(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const data::PreparedCharacter& c = dataset_.characters[i];
+    groups[i] = c.group.empty() ? c.name : c.group;
+    sources[i] = c.source;
+    augmented[i] = c.is_augmented_copy();
+  }
+  try {
+    split_ = data::validate_on_sources(split_, groups, sources, augmented, options.val_sources,
+                                       options.file + ": split '" + options.split +
+                                           "', data.val_sources");
+  } catch (const Error& e) {
+    throw IoError(e.what());
+  }
 }
 
 const std::vector<int>& RunData::part(const std::string& name) const {

@@ -16,6 +16,7 @@ DataOptions DataOptions::from(const config::Node& node) {
   f.required("file", o.file).check(!o.file.empty(), "file", "must not be empty");
   f.optional("split", o.split).check(!o.split.empty(), "split", "must not be empty");
   f.optional("distance", o.distance);
+  f.optional("val_sources", o.val_sources);
   if (!distance_registry().contains(o.distance)) {
     node["distance"].fail(distance_registry().unknown_key_message(o.distance));
   }

@@ -39,6 +39,7 @@
 #include <initializer_list>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "framework/core/config.hpp"
 
@@ -49,6 +50,10 @@ struct DataOptions {
   std::string file;                   ///< dataset file (relative paths: to the working directory)
   std::string split = "random";       ///< name of a split stored in the file
   std::string distance = "hollow_dist";  ///< a `distance` registry key the file was prepared with
+  /// Sources (their names in the dataset card) whose characters, with their variant groups,
+  /// form the validation part instead of the split's own; the rest of the split's train and val
+  /// parts trains (data::validate_on_sources). Empty: the split's parts as stored.
+  std::vector<std::string> val_sources;
 
   /// Decodes and checks a `data:` map (`file` required; `distance` must be a registered
   /// distance type). Errors name the file, line and key.

@@ -16,6 +16,7 @@
 #include "framework/core/error.hpp"
 #include "framework/core/progress.hpp"
 #include "framework/core/registry.hpp"
+#include "framework/core/text.hpp"
 #include "framework/train/fit_support.hpp"
 
 namespace skinlab::train {
@@ -202,6 +203,13 @@ TrainResult Trainer::fit(const RunDir& run, const FitLimits& limits) {
 
   const std::vector<int>& train = data_.part("train");
   const bool have_val = !data_.part("val").empty();
+  if (writer) {
+    spdlog::info("split '{}': {} training and {} validation characters{}", options_.data.split,
+                 train.size(), data_.part("val").size(),
+                 options_.data.val_sources.empty()
+                     ? ""
+                     : ", validating on the sources " + joined(options_.data.val_sources));
+  }
   if (!have_val && writer) {
     spdlog::warn("split '{}' has no validation characters: best.pt and early stopping use the "
                  "train loss", options_.data.split);

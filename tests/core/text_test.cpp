@@ -1,10 +1,12 @@
-// joined_keys (framework/core/text.hpp): the lists of what exists in error messages.
+// joined_keys and joined (framework/core/text.hpp): the lists of what exists in error messages.
 #include "framework/core/text.hpp"
 
 #include <gtest/gtest.h>
 
 #include <map>
+#include <set>
 #include <string>
+#include <vector>
 
 namespace skinlab {
 namespace {
@@ -15,6 +17,13 @@ TEST(JoinedKeys, KeysInTheMapsOrderOrTheWordForNone) {
   EXPECT_EQ(joined_keys(std::map<std::string, int>{{"random", 0}}), "random");
   EXPECT_EQ(joined_keys(std::map<std::string, double>{}), "none");
   EXPECT_EQ(joined_keys(std::map<std::string, double>{}, "(none)"), "(none)");
+}
+
+TEST(Joined, ValuesInTheContainersOrderOrTheWordForNone) {
+  EXPECT_EQ(joined(std::set<std::string>{"zeroad", "cube2"}), "cube2, zeroad");
+  EXPECT_EQ(joined(std::vector<std::string>{"zeroad", "cube2"}), "zeroad, cube2");
+  EXPECT_EQ(joined(std::vector<std::string>{}), "none");
+  EXPECT_EQ(joined(std::vector<std::string>{}, "(none)"), "(none)");
 }
 
 }  // namespace

@@ -247,6 +247,28 @@ TEST(Splits, UnknownHeldOutFamilyIsAnErrorListingTheFamilies) {
       {"leave_out_sources.all", "nothing to train on"});
 }
 
+TEST(Splits, ValidationOnSourcesMovesWholeGroupsAndDropsTheirAugmentedCopies) {
+  // 0-5 train (5 an augmented copy of 0), 6-7 val, 8 test; "q" holds 0, 6 and the test 8;
+  // 1 shares 0's group.
+  const data::Split split{{0, 1, 2, 3, 4, 5}, {6, 7}, {8}};
+  const std::vector<std::string> groups{"a", "a", "b", "c", "d", "a", "e", "f", "g"};
+  const std::vector<std::string> sources{"q", "r", "r", "r", "r", "q", "q", "r", "q"};
+  const std::vector<bool> augmented{false, false, false, false, false, true, false, false, false};
+  const data::Split s = validate_on_sources(split, groups, sources, augmented, {"q"}, "x");
+  EXPECT_EQ(s.val, (std::vector<int>{0, 1, 6}));
+  EXPECT_EQ(s.train, (std::vector<int>{2, 3, 4, 7}));
+  EXPECT_EQ(s.test, (std::vector<int>{8}));
+  testing::expect_error<Error>(
+      [&] { validate_on_sources(split, groups, sources, augmented, {"z"}, "x"); },
+      {"x: no training or validation character comes from source 'z'", "sources there: q, r"});
+  // Only an augmented copy would be left to train: that is nothing to train on.
+  testing::expect_error<Error>(
+      [&] {
+        validate_on_sources({{5}, {2}, {}}, groups, sources, augmented, {"r"}, "x");
+      },
+      {"x: validating on these sources leaves nothing to train on"});
+}
+
 TEST(Splits, OptionsAreValidated) {
   auto parse = [](const std::string& yaml) {
     return SplitOptions::from(config::Config::parse(yaml).root());
