@@ -81,7 +81,7 @@ void write_character(H5Writer& w, const PreparedCharacter& c) {
   w.write_attribute(g, "licence", c.licence);
   w.write_attribute(g, "attribution", c.attribution);
   w.write_attribute(g, "skeleton", c.skeleton);
-  w.write_attribute(g, "group", c.group.empty() ? c.name : c.group);
+  w.write_attribute(g, "group", c.variant_group());
   if (c.is_augmented_copy()) w.write_attribute(g, "augmented_from", c.augmented_from);
   w.write_attribute(g, "subdivision_levels", static_cast<std::int64_t>(c.subdivision_levels));
   if (!c.bind.empty()) {

@@ -112,6 +112,8 @@ struct PreparedCharacter {
   std::vector<AnimationData> animations;
 
   bool is_augmented_copy() const { return !augmented_from.empty(); }
+  /// The variant group as written to the file: `group`, or the character's own name when empty.
+  const std::string& variant_group() const { return group.empty() ? name : group; }
   int num_vertices() const { return static_cast<int>(V.rows()); }
   int num_joints() const { return static_cast<int>(joint_names.size()); }
   int num_bones() const { return static_cast<int>(bones.rows()); }

@@ -31,10 +31,6 @@ std::string cell(std::string s) {
   return out;
 }
 
-const std::string& group_of(const data::PreparedCharacter& c) {
-  return c.group.empty() ? c.name : c.group;
-}
-
 int source_vertices(const data::PreparedCharacter& c) {
   return static_cast<int>(c.vertex_map.size());
 }
@@ -121,7 +117,7 @@ std::string dataset_card_markdown(const data::Dataset& d, const fs::path& datase
     std::set<std::string> families, groups;
     for (int i : by_source[s]) {
       families.insert(d.characters[static_cast<std::size_t>(i)].skeleton);
-      groups.insert(group_of(d.characters[static_cast<std::size_t>(i)]));
+      groups.insert(d.characters[static_cast<std::size_t>(i)].variant_group());
     }
     all_families.insert(families.begin(), families.end());
     all_groups.insert(groups.begin(), groups.end());
@@ -252,7 +248,7 @@ std::string dataset_card_markdown(const data::Dataset& d, const fs::path& datase
     std::set<int> joints, bones;
     for (int i : members) {
       const auto& c = d.characters[static_cast<std::size_t>(i)];
-      groups.insert(group_of(c));
+      groups.insert(c.variant_group());
       fam_sources.insert(c.source);
       joints.insert(c.num_joints());
       bones.insert(c.num_bones());
@@ -282,7 +278,7 @@ std::string dataset_card_markdown(const data::Dataset& d, const fs::path& datase
     if (c.is_augmented_copy()) continue;
     std::string row =
         fmt::format("| {} | {} | {} | {} | {} | {} → {} | {} | {} | {} |", i, cell(c.name),
-                    c.source, cell(c.skeleton), cell(group_of(c)), source_vertices(c),
+                    c.source, cell(c.skeleton), cell(c.variant_group()), source_vertices(c),
                     c.num_vertices(), c.num_joints(), c.num_bones(), c.animations.size());
     for (const auto& [name, split] : d.splits)
       row += " " + split_of(split, static_cast<int>(i)) + " |";

@@ -32,7 +32,7 @@ RunData::RunData(const DataOptions& options) : options_(options), dataset_(read(
   std::vector<bool> augmented(n);
   for (std::size_t i = 0; i < n; ++i) {
     const data::PreparedCharacter& c = dataset_.characters[i];
-    groups[i] = c.group.empty() ? c.name : c.group;
+    groups[i] = c.variant_group();
     sources[i] = c.source;
     augmented[i] = c.is_augmented_copy();
   }
