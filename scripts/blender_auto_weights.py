@@ -13,7 +13,7 @@
 # as an artist would set up the rig by hand. Both files are
 # RigNet rig text in the glTF's frame (Y up); vertices Blender leaves without weight get no
 # `skin` line (`skinlab score --allow-unweighted` reads that). Prints IMPORT_S, SOLVE_S (the
-# parent_set call alone), VERTICES and UNWEIGHTED lines for scripts/compare_blender.
+# parent_set call alone), VERTICES, SPACED_JOINTS and UNWEIGHTED lines for scripts/compare_blender.
 #
 # Blender 3.4's glTF importer still uses numpy.bool, which numpy 1.24 (Debian 12) removed.
 import numpy
@@ -68,6 +68,12 @@ def main():
         raise SystemExit(f"{source}: {len(meshes)} meshes; expected one")
     mesh = meshes[0]
     print(f"VERTICES {len(mesh.data.vertices)}")
+    # RigNet rig text separates fields by whitespace, so a joint named "Body Dorsal" (OpenClonk's
+    # shark) cannot be written: say how many there are and write nothing.
+    spaced = [b.name for b in armature.data.bones if any(c.isspace() for c in b.name)]
+    print(f"SPACED_JOINTS {len(spaced)}")
+    if spaced:
+        return
     write_rig(artist_out, armature, mesh)
 
     if deform == "weighted":

@@ -17,6 +17,7 @@
 #include "framework/core/atomic_file.hpp"
 #include "framework/data/h5.hpp"
 #include "framework/geometry/import_character.hpp"
+#include "framework/geometry/load_character.hpp"
 #include "framework/geometry/rig_io.hpp"
 #include "framework/infer/parameters.hpp"
 #include "tests/cli/cli_run.hpp"
@@ -352,6 +353,33 @@ TEST(PredictCli, GameCharacterExportedFromItsSourceIsSkinnedAndRendered) {
   EXPECT_EQ(missing.status, 1);
   EXPECT_NE(missing.err.find("no character 'unicorn'"), std::string::npos) << missing.err;
   EXPECT_FALSE(fs::exists(dir / "u.glb"));
+
+  // Many characters in one reading of the sources: each as DIR/<name>.<format>; one unknown
+  // name among them writes nothing and names it.
+  const fs::path many = dir / "many";
+  const Result bad = run("export configs/datasets/zeroad_bundled.yaml goat unicorn --out-dir " +
+                         many.string());
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_NE(bad.err.find("no character 'unicorn'"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("nothing written"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(many));
+  const Result both = run("export configs/datasets/zeroad_bundled.yaml goat horse --out-dir " +
+                          many.string() + " --format obj");
+  ASSERT_EQ(both.status, 0) << both.err;
+  for (const std::string name : {"goat", "horse"}) {
+    EXPECT_TRUE(fs::exists(many / (name + ".obj"))) << name;
+    EXPECT_TRUE(fs::exists(many / (name + "_rig.txt"))) << name;
+  }
+  // The horse written as OBJ + rig is the horse written as glTF: same skeleton and vertices.
+  const geometry::Character from_obj =
+      geometry::load_character(many / "horse.obj", many / "horse_rig.txt");
+  EXPECT_EQ(from_obj.skeleton.names, artist.skeleton.names);
+  EXPECT_EQ(from_obj.mesh.num_vertices(), artist.mesh.num_vertices());
+  const Result two_to_one = run("export configs/datasets/zeroad_bundled.yaml goat horse --out " +
+                                (dir / "two.glb").string());
+  EXPECT_EQ(two_to_one.status, 1);
+  EXPECT_NE(two_to_one.err.find("--out names one file"), std::string::npos) << two_to_one.err;
+  EXPECT_FALSE(fs::exists(dir / "two.glb"));
 }
 
 TEST(PredictCli, RigNetQuickStartPairIsPredictedWithOneWarningAboutItsSkinLines) {
