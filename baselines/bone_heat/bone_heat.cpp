@@ -55,6 +55,78 @@ std::uint64_t edge_key(int a, int b) {
   return (static_cast<std::uint64_t>(a) << 32) | static_cast<std::uint32_t>(b);
 }
 
+/// One segment per joint, as Blender builds bones from a joint-only skeleton (its glTF
+/// importer's default "Temperance" bone heuristic, which the file comment describes): from the
+/// joint to its child when it has one, toward the mean of its children's offsets for the
+/// shortest child's length when it has several, and a leaf's helper bone (to its leaf tip when
+/// the skeleton has them) when it has none. Children at the joint itself (closer than
+/// kCoincident) are not directions; a joint with only such children is a point.
+void joint_segments(const geometry::Skeleton& skeleton, std::vector<Eigen::Vector3d>& root,
+                    std::vector<Eigen::Vector3d>& tip) {
+  constexpr double kCoincident = 1e-6;  // metres in the normalised frame
+  const auto children = skeleton.children();
+  const int nj = skeleton.num_joints();
+  root.assign(nj, Eigen::Vector3d::Zero());
+  tip.assign(nj, Eigen::Vector3d::Zero());
+  for (int j = 0; j < nj; ++j) {
+    root[j] = skeleton.positions.row(j).transpose();
+    if (children[j].empty()) {
+      tip[j] = skeleton.bone_end(geometry::Bone{j, j, true});
+      continue;
+    }
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    double shortest = std::numeric_limits<double>::infinity();
+    int counted = 0, nearest = -1;
+    for (int c : children[j]) {
+      const Eigen::Vector3d offset = skeleton.positions.row(c).transpose() - root[j];
+      if (offset.norm() <= kCoincident) continue;
+      mean += offset;
+      ++counted;
+      if (offset.norm() < shortest) {
+        shortest = offset.norm();
+        nearest = c;
+      }
+    }
+    if (counted == 0) {
+      tip[j] = root[j];
+    } else if (counted == 1 || mean.norm() <= kCoincident) {
+      tip[j] = skeleton.positions.row(nearest).transpose();  // children cancelling out: nearest
+    } else {
+      tip[j] = root[j] + shortest * mean.normalized();
+    }
+  }
+}
+
+/// #V×#J weights of joint_segments' sources as #V×#B bone weights: each joint's weight goes to
+/// the bone starting at that joint whose segment is nearest to the vertex (Euclidean), as the
+/// preprocessing's bone-level rule splits an artist's joint weight among a joint's bones by
+/// distance (data/preprocess.hpp). Every joint starts a bone (its children's or its helper).
+Eigen::MatrixXd onto_bones(const Eigen::MatrixXd& W, const geometry::Mesh& mesh,
+                           const geometry::Skeleton& skeleton,
+                           const std::vector<geometry::Bone>& bones) {
+  std::vector<std::vector<int>> starting(skeleton.num_joints());
+  for (int b = 0; b < static_cast<int>(bones.size()); ++b) starting[bones[b].start].push_back(b);
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(W.rows(), static_cast<Eigen::Index>(bones.size()));
+  for (Eigen::Index v = 0; v < W.rows(); ++v) {
+    const Eigen::Vector3d x = mesh.V.row(v).transpose();
+    for (int j = 0; j < skeleton.num_joints(); ++j) {
+      if (W(v, j) <= 0) continue;
+      int best = starting[j].front();
+      double best_distance = std::numeric_limits<double>::infinity();
+      for (int b : starting[j]) {
+        const double d = geometry::point_segment_distance(
+            x, skeleton.positions.row(j).transpose(), skeleton.bone_end(bones[b]));
+        if (d < best_distance) {
+          best_distance = d;
+          best = b;
+        }
+      }
+      out(v, best) += W(v, j);
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 BoneHeat::Options BoneHeat::Options::from(const config::Node& node) {
@@ -66,6 +138,9 @@ BoneHeat::Options BoneHeat::Options::from(const config::Node& node) {
   f.optional("closest", o.closest)
       .check(o.closest == "visible" || o.closest == "blender", "closest",
              "must be 'visible' or 'blender', got '" + o.closest + "'");
+  f.optional("heat_sources", o.heat_sources)
+      .check(o.heat_sources == "bones" || o.heat_sources == "joints", "heat_sources",
+             "must be 'bones' or 'joints', got '" + o.heat_sources + "'");
   f.optional("normal_weighted_distance", o.normal_weighted_distance);
   f.optional("orient_outward", o.orient_outward);
   f.optional("weight_limit_start", o.weight_limit_start)
@@ -94,13 +169,20 @@ Eigen::MatrixXd BoneHeat::bind(const geometry::Mesh& input, const geometry::Skel
   st.flipped_parts = orient.flipped_parts;
   const auto bones = skeleton.bones();
   const int nv = mesh.num_vertices();
-  const int nb = static_cast<int>(bones.size());
   const auto X = [&](int v) -> Eigen::Vector3d { return mesh.V.row(v).transpose(); };
-  std::vector<Eigen::Vector3d> root(nb), tip(nb);
-  for (int b = 0; b < nb; ++b) {
-    root[b] = skeleton.positions.row(bones[b].start).transpose();
-    tip[b] = skeleton.bone_end(bones[b]);
+  // The heat sources: one segment per bone, or per joint (`heat_sources: joints`). Below, "bone"
+  // b means source b; the sources' weights become bone weights at the end.
+  const bool per_joint = options_.heat_sources == "joints";
+  std::vector<Eigen::Vector3d> root, tip;
+  if (per_joint) {
+    joint_segments(skeleton, root, tip);
+  } else {
+    for (const auto& bone : bones) {
+      root.push_back(skeleton.positions.row(bone.start).transpose());
+      tip.push_back(skeleton.bone_end(bone));
+    }
   }
+  const int nb = static_cast<int>(root.size());
 
   // ---- triangles: normals, AABB tree, the Laplacian, areas, components ----------------------
   std::vector<int> good_faces;
@@ -329,7 +411,7 @@ Eigen::MatrixXd BoneHeat::bind(const geometry::Mesh& input, const geometry::Skel
     }
     W.row(v) /= sum;
   }
-  return W;
+  return per_joint ? onto_bones(W, mesh, skeleton, bones) : W;
 }
 
 }  // namespace skinlab::baselines

@@ -51,9 +51,18 @@
 ///   A row that the limit empties (only possible with > 20 bones sharing a vertex) keeps its
 ///   unlimited non-negative weights.
 ///
-/// Helper bones (zero-length, at leaf joints) are point sources like any other bone; Blender has
-/// no such bones (its leaf bone ends at the same point, so beyond a limb's tip the two tie and
-/// share the heat).
+/// Heat sources (`heat_sources`). `bones` (default; the bones every other method reads): one
+/// segment per parent–child pair, so a joint with several children (a chest with neck and
+/// shoulders, a neck with head and ears) owns a segment to each of them, and the helper bones
+/// at leaf joints (zero-length, or to the leaf's tip when the skeleton has leaf tips). `joints`:
+/// one segment per joint, as Blender builds an armature from a joint-only skeleton (a glTF; its
+/// importer's default "Temperance" bone heuristic): from the joint to its only child; with
+/// several children toward the mean of their offsets, as long as the nearest child is far (the
+/// heuristic takes the joint's local axis nearest that mean, which we do not have: joints carry
+/// no orientation here); at a leaf, the helper bone. Each joint's heat then goes to the bone
+/// starting at it nearest to the vertex. With `bones`, the segments from a branching joint to
+/// its children run through the children's regions (the head and ears of a neck with three
+/// children) and give them to the branching joint; Blender's bones start at each child.
 ///
 /// Not reproduced: Blender's X-mirror option, B-Bone segments and selected-bones-only binding.
 ///
@@ -93,6 +102,10 @@ class BoneHeat final : public binders::Binder {
   struct Options {
     double heat_constant = 1.0;           ///< c (Pinocchio; Blender C_WEIGHT), > 0
     std::string closest = "visible";      ///< "visible" or "blender" (see the file comment)
+    /// "bones": one heat source per bone of Skeleton::bones() (a segment per parent–child pair,
+    /// and the leaf helper bones); "joints": one per joint, as Blender's armature (see the file
+    /// comment).
+    std::string heat_sources = "bones";
     bool normal_weighted_distance = true;  ///< Blender's heat_source_distance; false: Euclidean
     /// Flip the faces of parts wound inwards first (geometry/orient_outward.hpp): the distance
     /// and the visibility test read front and back from the winding. Blender works with the

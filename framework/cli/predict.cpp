@@ -12,7 +12,9 @@
 /// run, the model loaded once. The command line (inputs, options, batch, summary) is
 /// infer/predict_command.hpp, shared with the Eigen-only `skinlab-predict`; this file adds what
 /// needs libtorch's side: the model (predict::Predictor, `--checkpoint`), `--compare-to-input`,
-/// `--render` and `--error-map`, and the commands `score`, `bundle` and `export-parameters`.
+/// `--render` and `--error-map`, `--binder` (a classical method's weights on the same
+/// preparation, infer/binder_engine.hpp), and the commands `score`, `bundle` and
+/// `export-parameters`.
 ///
 /// Input: an OBJ with `--rig` (RigNet rig text) or with a rig text next to it
 /// (geometry::rig_beside: `<stem>_rig.txt`, `<stem>.txt`, or `<id>_ori_rig.txt` for RigNet's
@@ -33,6 +35,7 @@
 #include "framework/cli/commands.hpp"
 #include "framework/core/error.hpp"
 #include "framework/geometry/load_character.hpp"
+#include "framework/infer/binder_engine.hpp"
 #include "framework/infer/model_dir.hpp"
 #include "framework/infer/outputs.hpp"
 #include "framework/infer/predict_command.hpp"
@@ -83,15 +86,37 @@ Command add_predict(CLI::App& app) {
                   "draw the character coloured by its most influential bone (.png)");
   cmd->add_flag("--error-map", args->error_map,
                 "with --render: add the per-vertex L1 error against the input's weights");
+  cmd->add_option("--binder", args->binder,
+                  "weights of a classical method instead of the network, on the character "
+                  "prepared as --model's inputs (pruned and mapped back alike): a binder type "
+                  "(bone_heat, geo_voxel), YAML like '{type: bone_heat, closest: blender}', or a "
+                  "config file with a binder: section");
   infer::PredictHooks hooks;
-  hooks.load = [](const fs::path& dir, const infer::PredictArgs& a) {
+  hooks.load = [](const fs::path& dir,
+                  const infer::PredictArgs& a) -> std::unique_ptr<infer::PredictEngine> {
+    if (!a.binder.empty()) {
+      return std::make_unique<infer::BinderEngine>(infer::BinderEngine::load(a.binder, dir));
+    }
     return std::make_unique<predict::Predictor>(predict::Predictor::load(dir, a.checkpoint));
   };
-  hooks.before_write = [](const geometry::Character& input, const predict::Prediction& p,
-                          const infer::PredictEngine& engine, const infer::PredictArgs& a) {
+  // --compare-to-input reads the model's metrics; with --binder the model is loaded for them
+  // once, on the first comparison.
+  auto metrics_model = std::make_shared<std::unique_ptr<predict::Predictor>>();
+  hooks.before_write = [metrics_model](const geometry::Character& input,
+                                       const predict::Prediction& p,
+                                       const infer::PredictEngine& engine,
+                                       const infer::PredictArgs& a) {
     if (!a.compare) return;
-    const auto& predictor = static_cast<const predict::Predictor&>(engine);
-    print_metrics(input.name + " against the input's weights:", predictor.compare(p));
+    const auto* predictor = dynamic_cast<const predict::Predictor*>(&engine);
+    if (predictor == nullptr) {
+      if (!*metrics_model) {
+        const fs::path dir = a.model.empty() ? infer::default_model() : fs::path(a.model);
+        *metrics_model =
+            std::make_unique<predict::Predictor>(predict::Predictor::load(dir, a.checkpoint));
+      }
+      predictor = metrics_model->get();
+    }
+    print_metrics(input.name + " against the input's weights:", predictor->compare(p));
   };
   hooks.after_write = render_prediction;
   return {cmd, [args, hooks] { return infer::run_predict(*args, hooks); }};

@@ -49,6 +49,7 @@ struct PredictArgs {
   bool compare = false;    ///< skinlab predict --compare-to-input
   bool timings = false;
   std::string render;      ///< skinlab predict --render
+  std::string binder;      ///< skinlab predict --binder (infer/binder_engine.hpp)
   bool error_map = false;  ///< skinlab predict --error-map
 };
 

@@ -170,8 +170,8 @@ PreparedInput prepare_to_predict(const geometry::Character& character,
 
 Prediction finish_prediction(PreparedInput input, const std::string& distance,
                              data::RowMatrixXf candidates, double prune, StageTimes* times) {
-  auto start = Clock::now();
-  data::PreparedCharacter& prepared = input.prepared;
+  const auto start = Clock::now();
+  const data::PreparedCharacter& prepared = input.prepared;
   const data::DistanceData& d = prepared.distances.at(distance);
   const std::string& name = prepared.name;
   if (candidates.rows() != d.topk_index.rows() || candidates.cols() != d.topk_index.cols()) {
@@ -180,7 +180,7 @@ Prediction finish_prediction(PreparedInput input, const std::string& distance,
                             name, candidates.rows(), candidates.cols(), d.topk_index.rows(),
                             d.topk_index.cols(), distance));
   }
-  // The distribution over the K candidates as #V×#B bone weights, pruned (Sec. 4.5).
+  // The distribution over the K candidates as #V×#B bone weights.
   data::RowMatrixXd W = data::RowMatrixXd::Zero(candidates.rows(), prepared.num_bones());
   for (Eigen::Index v = 0; v < candidates.rows(); ++v) {
     for (Eigen::Index k = 0; k < candidates.cols(); ++k) {
@@ -193,15 +193,41 @@ Prediction finish_prediction(PreparedInput input, const std::string& distance,
       W(v, d.topk_index(v, k)) = w;
     }
   }
-  prune_rows(W, prune);
+  if (times != nullptr) times->network += seconds_since(start);
+  Prediction out = finish_bone_weights(std::move(input), distance, std::move(W), prune,
+                                       "the network", times);
+  out.candidates = std::move(candidates);
+  return out;
+}
+
+Prediction finish_bone_weights(PreparedInput input, const std::string& distance,
+                               data::RowMatrixXd W, double prune, const std::string& method,
+                               StageTimes* times) {
+  auto start = Clock::now();
+  data::PreparedCharacter& prepared = input.prepared;
+  const data::DistanceData& d = prepared.distances.at(distance);
+  const std::string& name = prepared.name;
+  if (W.rows() != prepared.num_vertices() || W.cols() != prepared.num_bones()) {
+    throw Error(fmt::format("{}: {} gave {}×{} bone weights; expected #V×#B = {}×{}", name, method,
+                            W.rows(), W.cols(), prepared.num_vertices(), prepared.num_bones()));
+  }
+  for (Eigen::Index v = 0; v < W.rows(); ++v) {
+    for (Eigen::Index b = 0; b < W.cols(); ++b) {
+      if (!(std::isfinite(W(v, b)) && W(v, b) >= 0)) {
+        throw Error(fmt::format("{}: {} gave vertex {} (of the prepared mesh) the weight {} for "
+                                "bone {}",
+                                name, method, v, W(v, b), b));
+      }
+    }
+  }
+  prune_rows(W, prune);  // Sec. 4.5
   for (Eigen::Index v = 0; v < W.rows(); ++v) {
     if (!(W.row(v).sum() > 0)) {
-      throw Error(fmt::format("{}: the network gave vertex {} (of the prepared mesh) no weight",
-                              name, v));
+      throw Error(fmt::format("{}: {} gave vertex {} (of the prepared mesh) no weight", name,
+                              method, v));
     }
   }
   Prediction out;
-  out.candidates = std::move(candidates);
   out.prepared_weights = W.cast<float>();
   if (prepared.weights.rows() > 0 || prepared.weights.cols() > 0) {
     // The truth by the preprocessing's own bone-level rule, from D as stored (float32).

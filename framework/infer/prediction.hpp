@@ -90,6 +90,7 @@ struct PreparedInput {
 struct Prediction {
   data::PreparedCharacter prepared;      ///< normalised, merged, subdivided; weights if given
   data::RowMatrixXf candidates;          ///< #V×K network output over prepared.topk_index
+                                         ///< (empty for a binder: finish_bone_weights)
   data::RowMatrixXf prepared_weights;    ///< #V×#B at the prepared vertices, pruned
   data::RowMatrixXf source_weights;      ///< #V_in×#B at the input's vertices, pruned
   /// #V_in×#J per-joint weights at the input's vertices and joints (a left-out joint's column
@@ -126,5 +127,13 @@ PreparedInput prepare_to_predict(const geometry::Character& character,
 Prediction finish_prediction(PreparedInput input, const std::string& distance,
                              data::RowMatrixXf candidates, double prune,
                              StageTimes* times = nullptr);
+
+/// Step 4 for weights that are already per bone: `W` (#V×#B at `input.prepared`'s vertices,
+/// from `method`, e.g. "binder 'bone_heat'", which error messages name) checked (finite, ≥ 0),
+/// pruned, checked again (every vertex keeps a weight) and mapped back as finish_prediction
+/// does; the result's `candidates` is empty. `times->network` receives the checks and pruning.
+Prediction finish_bone_weights(PreparedInput input, const std::string& distance,
+                               data::RowMatrixXd W, double prune, const std::string& method,
+                               StageTimes* times = nullptr);
 
 }  // namespace skinlab::infer

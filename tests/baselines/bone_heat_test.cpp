@@ -1,6 +1,7 @@
 // Bone heat (baselines/bone_heat, Blender's automatic weights): validity, locality, symmetry,
-// monotonicity on a tube, visibility on two fingers, the Euclidean fallback for a part that
-// sees no bone, Blender's weight limit, option errors, and the real Minetest player.
+// monotonicity on a tube, one heat source per joint (Blender's armature), visibility on two
+// fingers, the Euclidean fallback for a part that sees no bone, Blender's weight limit, option
+// errors, and the real Minetest player.
 
 #include "baselines/bone_heat/bone_heat.hpp"
 
@@ -28,6 +29,7 @@ TEST(BoneHeat, RegisteredWithBlendersConstants) {
   ASSERT_NE(h, nullptr);
   EXPECT_DOUBLE_EQ(h->options().heat_constant, 1.0);
   EXPECT_EQ(h->options().closest, "visible");
+  EXPECT_EQ(h->options().heat_sources, "bones");
   EXPECT_TRUE(h->options().normal_weighted_distance);
   EXPECT_DOUBLE_EQ(h->options().weight_limit_start, 0.05);
   EXPECT_DOUBLE_EQ(h->options().weight_limit_end, 0.025);
@@ -135,6 +137,63 @@ TEST(BoneHeat, SmallWeightsAreCutAsBlenderDoes) {
   EXPECT_GT(cut, 0);
 }
 
+// Without a branching joint, one source per joint is one source per bone: the same weights.
+TEST(BoneHeat, JointSourcesOnAChainAreTheBoneSources) {
+  const Chain c = testing::chain();
+  const Eigen::MatrixXd bones = BoneHeat({}).bind(c.mesh, c.skeleton);
+  BoneHeat::Options o;
+  o.heat_sources = "joints";
+  const Eigen::MatrixXd joints = BoneHeat(o).bind(c.mesh, c.skeleton);
+  expect_valid_rows(joints, c.mesh.num_vertices(), 4);
+  EXPECT_LT((joints - bones).cwiseAbs().maxCoeff(), 1e-12);
+}
+
+// A neck (j1) with two children, as a Quaternius husky's neck carries its head and ears: with
+// one source per bone, the segment j1→ear runs up through the head and gives the top of the
+// tube to j1; with one source per joint (Blender's armature), j1's bone points between its
+// children for the nearer child's length and the top goes to the head and the ear.
+TEST(BoneHeat, JointSourcesKeepABranchingJointOutOfItsChildrensRegion) {
+  Chain c = testing::chain();
+  Eigen::MatrixXd J(4, 3);
+  J << 0, 0.1, 0, 0, 0.4, 0, 0, 0.65, 0, 0.03, 0.9, 0;
+  c.skeleton = geometry::Skeleton::from_parent_names({"j0", "j1", "head", "ear"}, J,
+                                                     {"", "j0", "j1", "j1"}, "neck");
+  // bones(): j0→j1, j1→head, helper head, j1→ear, helper ear.
+  const auto bones = c.skeleton.bones();
+  ASSERT_EQ(bones.size(), 5u);
+  const auto weight_of = [&](const Eigen::MatrixXd& W, int v, const std::string& joint) {
+    double w = 0;
+    for (std::size_t b = 0; b < bones.size(); ++b) {
+      if (c.skeleton.names[bones[b].start] == joint) w += W(v, static_cast<Eigen::Index>(b));
+    }
+    return w;
+  };
+  const Eigen::MatrixXd per_bone = BoneHeat({}).bind(c.mesh, c.skeleton);
+  BoneHeat::Options o;
+  o.heat_sources = "joints";
+  const Eigen::MatrixXd per_joint = BoneHeat(o).bind(c.mesh, c.skeleton);
+  expect_valid_rows(per_joint, c.mesh.num_vertices(), 5);
+  double j1_per_bone = 0, j1_per_joint = 0;  // mean weight of j1 over rings 30–33 (y 0.80–0.875)
+  int n = 0;
+  for (int i = 30; i <= 33; ++i) {
+    for (int j = 0; j < Chain::kSides; ++j, ++n) {
+      j1_per_bone += weight_of(per_bone, Chain::vertex(i, j), "j1");
+      j1_per_joint += weight_of(per_joint, Chain::vertex(i, j), "j1");
+    }
+  }
+  j1_per_bone /= n;
+  j1_per_joint /= n;
+  std::cout << "j1's mean weight at the top: one source per bone " << j1_per_bone
+            << ", per joint " << j1_per_joint << "\n";
+  EXPECT_GT(j1_per_bone, 0.3);
+  EXPECT_LT(j1_per_joint, 0.1);
+  // The middle of the neck (ring 10, y = 0.3) stays j0's and j1's either way.
+  for (int j = 0; j < Chain::kSides; ++j) {
+    const int v = Chain::vertex(10, j);
+    EXPECT_GT(weight_of(per_joint, v, "j0") + weight_of(per_joint, v, "j1"), 0.95);
+  }
+}
+
 TEST(BoneHeat, BadOptionsNameTheField) {
   expect_error<ConfigError>([] { make_binder("{type: bone_heat, heat_constant: 0}"); },
                             {"test.yaml:1", "heat_constant", "must be positive"});
@@ -145,6 +204,8 @@ TEST(BoneHeat, BadOptionsNameTheField) {
       {"weight_limit_end", "must be in [0, weight_limit_start)"});
   expect_error<ConfigError>([] { make_binder("{type: bone_heat, weight_limit_start: 2}"); },
                             {"weight_limit_start", "must be in [0, 1]"});
+  expect_error<ConfigError>([] { make_binder("{type: bone_heat, heat_sources: segments}"); },
+                            {"heat_sources", "must be 'bones' or 'joints'"});
   expect_error<ConfigError>([] { make_binder("{type: bone_heat, heat: 1}"); },
                             {"heat", "unknown field"});
 }

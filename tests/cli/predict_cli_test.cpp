@@ -2,7 +2,8 @@
 // with rig text, and the corpus of bad inputs in tests/data/bad/ (each a one-line error naming
 // the file and the element, a non-zero exit, and an existing output file left as it was);
 // RigNet's quick-start pairs (tests/data/rignet/: remeshed OBJs with the rig texts of their
-// original meshes); and many characters in one run (--out-dir: files, a directory, a list).
+// original meshes); many characters in one run (--out-dir: files, a directory, a list); and a
+// classical method in the network's place (--binder).
 
 #include <gtest/gtest.h>
 
@@ -276,6 +277,54 @@ TEST(PredictCli, BundledModelSkinsARealCharacterAndAPlainObj) {
   const geometry::Character box = geometry::import_character(dir / "box.gltf", o);
   EXPECT_EQ(box.skeleton.names, (std::vector<std::string>{"root", "mid", "top"}));
   EXPECT_EQ(box.mesh.num_vertices(), 8);
+}
+
+// --binder: a classical method on the model's preparation, pruned and mapped back alike; its
+// weights are bone heat's, not the network's, and a bad binder is an error before any work.
+TEST(PredictCli, BinderSkinsTheCharacterInsteadOfTheNetwork) {
+  TempDir dir;
+  const fs::path heat = dir / "heat_rig.txt", joints = dir / "joints_rig.txt",
+                 file = dir / "file_rig.txt", net = dir / "net_rig.txt";
+  const Result r = run("predict " + kPlayer + " --binder bone_heat --compare-to-input --out " +
+                       heat.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("against the input's weights: avg_l1"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("binder 'bone_heat' on the preparation of"), std::string::npos) << r.err;
+  ASSERT_EQ(run("predict " + kPlayer + " --binder '{type: bone_heat, heat_sources: joints}' "
+                "--out " + joints.string()).status, 0);
+  ASSERT_EQ(run("predict " + kPlayer + " --binder configs/baselines/bone_heat.yaml --out " +
+                file.string()).status, 0);
+  ASSERT_EQ(run("predict " + kPlayer + " --out " + net.string()).status, 0);
+  const geometry::Character input = geometry::import_character(kPlayer);
+  const int nv = input.mesh.num_vertices();
+  const Eigen::MatrixXd W(geometry::read_rig(heat, nv).weights);
+  ASSERT_EQ(W.cols(), input.skeleton.num_joints());
+  for (int v = 0; v < nv; ++v) ASSERT_NEAR(W.row(v).sum(), 1.0, 1e-5) << "vertex " << v;
+  // The config file names bone heat with the options of configs/baselines/bone_heat.yaml.
+  const Eigen::MatrixXd from_file(geometry::read_rig(file, nv).weights);
+  const double to_joints = (Eigen::MatrixXd(geometry::read_rig(joints, nv).weights) - W)
+                               .cwiseAbs().maxCoeff();
+  const double to_file = (from_file - W).cwiseAbs().maxCoeff();
+  const double to_network = (Eigen::MatrixXd(geometry::read_rig(net, nv).weights) - W)
+                                .cwiseAbs().maxCoeff();
+  EXPECT_LT(to_file, 1e-6);
+  EXPECT_GT(to_joints, 0.1) << "the player's body joint has three children";
+  EXPECT_GT(to_network, 0.1);
+
+  const std::string out = " --out " + (dir / "bad.glb").string();
+  const std::vector<std::pair<std::string, std::vector<std::string>>> bad = {
+      {"nonsense", {"unknown binder type 'nonsense'", "bone_heat"}},
+      {"artist_weights", {"'artist_weights' is a reference row"}},
+      {"'{type: bone_heat, closest: nearest}'", {"closest", "must be 'visible' or 'blender'"}},
+      {"'{closest: blender}'", {"binder"}},
+      {"configs/base.yaml", {"configs/base.yaml", "no binder: section"}}};
+  for (const auto& [spec, words] : bad) {
+    const Result e = run("predict " + kPlayer + " --binder " + spec + out);
+    EXPECT_EQ(e.status, 1) << spec;
+    ASSERT_EQ(error_lines(e.err).size(), 1u) << spec << ": " << e.err;
+    for (const auto& w : words) EXPECT_NE(e.err.find(w), std::string::npos) << spec << ": " << e.err;
+  }
+  EXPECT_FALSE(fs::exists(dir / "bad.glb"));
 }
 
 TEST(PredictCli, GameCharacterExportedFromItsSourceIsSkinnedAndRendered) {
