@@ -19,8 +19,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// The `binder:` node of `spec`, and where it came from for messages. A file keeps its config
-/// alive through the returned Config.
+/// The binder type of `spec` and its options node (empty for a bare key); `config` owns the tree
+/// the node views.
 struct BinderSpec {
   config::Config config;
   config::Node node;
