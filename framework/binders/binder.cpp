@@ -8,8 +8,11 @@
 
 namespace skinlab::binders {
 
-void check_weights(const Eigen::MatrixXd& W, int num_vertices, int num_bones,
-                   const std::string& what) {
+Eigen::MatrixXd bind_checked(const Binder& binder, const geometry::Mesh& mesh,
+                             const geometry::Skeleton& skeleton, const std::string& what) {
+  Eigen::MatrixXd W = binder.bind(mesh, skeleton);
+  const Eigen::Index num_vertices = mesh.V.rows();
+  const auto num_bones = static_cast<Eigen::Index>(skeleton.bones().size());
   if (W.rows() != num_vertices || W.cols() != num_bones) {
     throw Error(fmt::format("{} returned {}×{} weights, expected {}×{}", what, W.rows(), W.cols(),
                             num_vertices, num_bones));
@@ -21,6 +24,7 @@ void check_weights(const Eigen::MatrixXd& W, int num_vertices, int num_bones,
                               W.row(v).minCoeff()));
     }
   }
+  return W;
 }
 
 std::string reference_row_prior(const config::Node& node) {

@@ -55,10 +55,11 @@ inline bool is_reference_row(const std::string& type) {
 /// for the other two). Called when a config is read and by the evaluator.
 std::string reference_row_prior(const config::Node& node);
 
-/// Checks a binder's result against the contract of Binder::bind: #V×#B (`num_vertices` ×
-/// `num_bones`), entries ≥ 0, rows summing to 1 within 1e-4. Throws Error starting with `what`
-/// (the binder and the character) and naming the first bad vertex.
-void check_weights(const Eigen::MatrixXd& W, int num_vertices, int num_bones,
-                   const std::string& what);
+/// `binder.bind(mesh, skeleton)`, checked against the contract of Binder::bind: #V×#B (#B =
+/// `skeleton.bones().size()`), entries ≥ 0, rows summing to 1 within 1e-4. Throws Error starting
+/// with `what` (the binder and the character) and naming the first bad vertex. Every caller of a
+/// binder (the evaluator, the dataset's priors, `predict --binder`) goes through it.
+Eigen::MatrixXd bind_checked(const Binder& binder, const geometry::Mesh& mesh,
+                             const geometry::Skeleton& skeleton, const std::string& what);
 
 }  // namespace skinlab::binders

@@ -381,6 +381,13 @@ geometry::Skeleton PreparedCharacter::rig() const {
   return s;
 }
 
+geometry::Mesh PreparedCharacter::mesh() const {
+  geometry::Mesh m;
+  m.V = V;
+  m.F = F;
+  return m;
+}
+
 const std::vector<float>* PreparedCharacter::bind_pose() const {
   if (!bind.empty()) return &bind;
   if (!animations.empty()) return &animations.front().bind;

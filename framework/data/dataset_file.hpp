@@ -19,6 +19,7 @@
 
 #include "framework/data/source.hpp"
 #include "framework/data/h5.hpp"
+#include "framework/geometry/mesh.hpp"
 #include "framework/geometry/skin_weights.hpp"
 
 namespace skinlab::data {
@@ -123,6 +124,9 @@ struct PreparedCharacter {
   /// throws IoError naming the character when its `bones()` are not the stored `bones` (a file
   /// written with another bone convention).
   geometry::Skeleton rig() const;
+  /// The character's mesh (`V`, `F`), in the normalised frame as stored: with rig(), what a
+  /// binder is given.
+  geometry::Mesh mesh() const;
 };
 
 /// Index lists into Dataset::characters.

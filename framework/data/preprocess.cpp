@@ -293,9 +293,8 @@ PreparedCharacter preprocess(const datasets::SourceCharacter& source,
   // 4b. Priors: a binder's weights on the same mesh and bones.
   for (const auto& node : options.priors) {
     const std::string type = node.required_type("binder");
-    const Eigen::MatrixXd P = binder_registry().create(node)->bind(mesh, c.skeleton);
-    binders::check_weights(P, mesh.num_vertices(), static_cast<int>(bones.size()),
-                           "binder '" + type + "' on " + where);
+    const Eigen::MatrixXd P = binders::bind_checked(*binder_registry().create(node), mesh,
+                                                    c.skeleton, "binder '" + type + "' on " + where);
     out.priors.emplace(type, P.cast<float>());
   }
 

@@ -60,22 +60,11 @@ std::map<std::string, double> mean_values(const std::vector<CharacterResult>& ch
 
 namespace {
 
-/// The prepared character's mesh and skeleton in the normalised frame, for a binder. Throws
-/// when the skeleton's bone order differs from the stored bones (PreparedCharacter::skeleton).
-std::pair<geometry::Mesh, geometry::Skeleton> geometry_of(const data::PreparedCharacter& c) {
-  geometry::Mesh mesh;
-  mesh.V = c.V;
-  mesh.F = c.F;
-  return {std::move(mesh), c.rig()};
-}
-
 /// #V×#B float32 bone weights of a binder, checked against the Binder contract.
 torch::Tensor bind_weights(const binders::Binder& binder, const std::string& type,
                            const data::PreparedCharacter& c) {
-  const auto [mesh, skeleton] = geometry_of(c);
-  const Eigen::MatrixXd W = binder.bind(mesh, skeleton);
-  binders::check_weights(W, c.num_vertices(), c.num_bones(),
-                         fmt::format("binder '{}' on '{}'", type, c.name));
+  const Eigen::MatrixXd W = binders::bind_checked(binder, c.mesh(), c.rig(),
+                                                 fmt::format("binder '{}' on '{}'", type, c.name));
   const data::RowMatrixXf Wf = W.cast<float>();
   return torch::from_blob(const_cast<float*>(Wf.data()), {Wf.rows(), Wf.cols()}, torch::kFloat32)
       .clone();

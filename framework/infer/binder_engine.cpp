@@ -87,13 +87,9 @@ Prediction BinderEngine::predict(const geometry::Character& character,
   PreparedInput input = prepare_to_predict(character, preparation_, options, times);
   const auto start = std::chrono::steady_clock::now();
   const data::PreparedCharacter& c = input.prepared;
-  geometry::Mesh mesh;
-  mesh.V = c.V;
-  mesh.F = c.F;
   const std::string method = fmt::format("binder '{}'", type_);
-  const Eigen::MatrixXd W = binder_->bind(mesh, c.rig());
-  binders::check_weights(W, c.num_vertices(), c.num_bones(),
-                         fmt::format("{} on '{}'", method, c.name));
+  const Eigen::MatrixXd W =
+      binders::bind_checked(*binder_, c.mesh(), c.rig(), fmt::format("{} on '{}'", method, c.name));
   if (times != nullptr) times->network += seconds_since(start);
   return finish_bone_weights(std::move(input), distance(), W, options.prune, method, times);
 }
