@@ -67,17 +67,13 @@ BinderEngine BinderEngine::load(const std::string& spec, const fs::path& dir) {
   BinderEngine e;
   e.type_ = binder.type;
   e.binder_ = binder_registry().create(e.type_, binder.node);
-  const fs::path config_file = dir / "config.yaml";
-  if (!fs::is_directory(dir) || !fs::exists(config_file)) {
-    throw IoError(dir.string() + ": not a model directory (no config.yaml); --binder takes its "
-                  "preparation from a run directory or a bundled model");
-  }
+  const fs::path config_file = model_config_file(
+      dir, "--binder takes its preparation from a run directory or a bundled model");
   const config::Node data = config::Config::load(config_file).root()["data"];
   const std::string data_file = data.has("file") ? data["file"].as<std::string>() : "";
   const std::string distance = data["distance"].as<std::string>();
-  // Without the model's priors (parse_preparation's empty `prior`): the binder is the method.
-  e.preparation_ = parse_preparation(read_preparation(dir, data_file), dir / "preparation.yaml",
-                                     dir, distance);
+  // Without the model's priors (load_preparation's empty `prior`): the binder is the method.
+  e.preparation_ = load_preparation(dir, data_file, distance);
   e.description_ = fmt::format("binder '{}' on the preparation of {}", e.type_, dir.string());
   return e;
 }

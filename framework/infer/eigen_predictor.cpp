@@ -96,9 +96,7 @@ EigenPredictor EigenPredictor::load(const fs::path& dir) {
     const config::Node data = config::Config::load(config_file).root()["data"]["file"];
     if (data.exists()) data_file = data.as<std::string>();
   }
-  Preparation preparation =
-      parse_preparation(read_preparation(dir, data_file), dir / "preparation.yaml", dir,
-                        parameters.distance, network.prior());
+  Preparation preparation = load_preparation(dir, data_file, parameters.distance, network.prior());
   if (preparation.preprocess.top_k != network.top_k()) {
     throw ConfigError(fmt::format("{}: the preparation picks {} candidate bones per vertex, but "
                                   "the network of {} takes K = {}",

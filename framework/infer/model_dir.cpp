@@ -53,6 +53,14 @@ fs::path default_model() {
               (build_tree ? "" : " (a program outside its build tree does not use the source tree)"));
 }
 
+fs::path model_config_file(const fs::path& dir, const std::string& hint) {
+  fs::path file = dir / "config.yaml";
+  if (!fs::is_directory(dir) || !fs::exists(file)) {
+    throw IoError(dir.string() + ": not a model directory (no config.yaml); " + hint);
+  }
+  return file;
+}
+
 std::string read_preparation(const fs::path& dir, const std::string& data_file) {
   const fs::path own = dir / "preparation.yaml";
   if (fs::exists(own)) return read_file(own);
@@ -93,6 +101,12 @@ Preparation parse_preparation(const std::string& yaml, const fs::path& file, con
                       "', which its preparation does not list");
   }
   return p;
+}
+
+Preparation load_preparation(const fs::path& dir, const std::string& data_file,
+                             const std::string& distance, const std::string& prior) {
+  return parse_preparation(read_preparation(dir, data_file), dir / "preparation.yaml", dir,
+                           distance, prior);
 }
 
 }  // namespace skinlab::infer

@@ -30,6 +30,10 @@ namespace skinlab::infer {
 /// None: an Error naming every place looked at. Logs (info) which one was taken.
 std::filesystem::path default_model();
 
+/// `dir`/config.yaml, the file every model directory has. IoError "<dir>: not a model directory
+/// (no config.yaml); <hint>" when `dir` is not a directory or has none.
+std::filesystem::path model_config_file(const std::filesystem::path& dir, const std::string& hint);
+
 /// `dir`'s preparation YAML: `<dir>/preparation.yaml`, or else the `preparation` attribute of
 /// the dataset file `data_file` (a run's `data.file`; empty: none). IoError naming the file
 /// that is missing.
@@ -42,5 +46,11 @@ std::string read_preparation(const std::filesystem::path& dir, const std::string
 Preparation parse_preparation(const std::string& yaml, const std::filesystem::path& file,
                               const std::filesystem::path& dir, const std::string& distance,
                               const std::string& prior = "");
+
+/// parse_preparation(read_preparation(dir, data_file), ...): the preparation a model directory
+/// predicts with, given its config's `data.file` and `data.distance` and the prior its model
+/// reads (empty: none).
+Preparation load_preparation(const std::filesystem::path& dir, const std::string& data_file,
+                             const std::string& distance, const std::string& prior = "");
 
 }  // namespace skinlab::infer

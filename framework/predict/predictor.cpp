@@ -31,11 +31,8 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
 Predictor Predictor::load(const fs::path& dir, const std::string& checkpoint) {
-  const fs::path config_file = dir / "config.yaml";
-  if (!fs::is_directory(dir) || !fs::exists(config_file)) {
-    throw IoError(dir.string() + ": not a model directory (no config.yaml); give a run directory "
-                  "of skinlab train or a bundled model (results/bundled/<name>)");
-  }
+  const fs::path config_file = infer::model_config_file(
+      dir, "give a run directory of skinlab train or a bundled model (results/bundled/<name>)");
   const config::Config config = config::Config::load(config_file);
   Predictor p;
   p.options_ = train::RunOptions::from(config);
@@ -55,9 +52,8 @@ Predictor Predictor::load(const fs::path& dir, const std::string& checkpoint) {
     }
   }
 
-  p.preparation_ = infer::parse_preparation(infer::read_preparation(dir, p.options_.data.file),
-                                            dir / "preparation.yaml", dir, p.options_.data.distance,
-                                            model_prior(p.options_));
+  p.preparation_ = infer::load_preparation(dir, p.options_.data.file, p.options_.data.distance,
+                                           model_prior(p.options_));
 
   p.model_ = train::build_model(p.options_);
   const train::TrainingState state = train::load_checkpoint(weights, *p.model_);
