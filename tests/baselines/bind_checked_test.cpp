@@ -20,7 +20,7 @@ namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
 using testing::Chain;
 using testing::expect_error;
 
-/// A binder that returns whatever `make` gives for the mesh's vertex and the skeleton's bone
+/// A binder that returns whatever `make` gives for the mesh's vertex count and the skeleton's bone
 /// count: all weight on bone 0 unless a test changes it.
 class ScriptedBinder final : public binders::Binder {
  public:
