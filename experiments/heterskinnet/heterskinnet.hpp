@@ -42,6 +42,9 @@
 /// ε (1e-3) bounds the correction needed to give weight to a candidate the prior leaves at 0
 /// (|log ε| ≈ 6.9). Motivation, measured: on games from unseen sources bone heat had lower L1
 /// than the network (experiments/heterskinnet/README.md, "Skinning beyond one game").
+/// `keep_prior_outside: true` changes only evaluation and prediction: the prior keeps its own
+/// weight on the bones outside the K candidates and the candidates share the prior's mass on
+/// them as w_v says (infer::keep_prior_outside), so a zero head reproduces the prior itself.
 ///
 /// Ablations are configs: `configs/ablations/no_heterconv.yaml` lists `local`/`stem` without the
 /// `b2v`/`v2b` ops (the head still reads the K candidates' bone features: without an

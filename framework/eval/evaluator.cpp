@@ -17,7 +17,9 @@
 #include "framework/eval/evaluate.hpp"
 #include "framework/eval/metric.hpp"
 #include "framework/eval/predictions.hpp"
+#include "framework/infer/prediction.hpp"
 #include "framework/losses/loss.hpp"
+#include "framework/models/branched_model.hpp"
 #include "framework/models/model.hpp"
 #include "framework/train/checkpoint.hpp"
 #include "framework/train/distributed.hpp"
@@ -137,6 +139,7 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
   std::shared_ptr<models::Model> model;
   std::shared_ptr<binders::Binder> binder;
   std::string method_type, prior_type;
+  std::string prior_outside;  // the prior whose weight off the candidates a model's rows keep
   std::int64_t epoch = 0;
   std::unique_ptr<losses::LossSum> loss;
   if (is_binder) {
@@ -148,6 +151,10 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
     }
   } else {
     model = train::build_model(o);
+    if (const models::PriorOptions prior = models::PriorOptions::of(o.model);
+        prior.keep_prior_outside) {
+      prior_outside = prior.prior;
+    }
     epoch = train::load_checkpoint(checkpoint, *model).epoch;
     loss = std::make_unique<losses::LossSum>(losses::LossSum::from(o.losses));
     model->eval();
@@ -190,6 +197,7 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
         data.dataset().characters[static_cast<std::size_t>(index)];
     const data::CharacterTensors& c = data.tensors(index);
     torch::Tensor candidates, weights;
+    torch::Tensor network_weights;  // a model's own scatter, which its training loss scores
     if (method_type == binders::kArtistWeights) {
       weights = c.bone_weights;
       candidates = weights.gather(1, c.topk_index);
@@ -205,7 +213,12 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
     } else {
       candidates = model->forward(c);
       train::check_prediction(candidates, c, o);
-      weights = data::scatter_to_bones(candidates, c.topk_index, c.num_bones());
+      weights = network_weights = data::scatter_to_bones(candidates, c.topk_index, c.num_bones());
+      if (!prior_outside.empty()) {
+        data::RowMatrixXd W = to_eigen(weights).cast<double>();
+        infer::keep_prior_outside(W, character, o.data.distance, prior_outside);
+        weights = data::to_float(W);
+      }
     }
 
     CharacterResult r;
@@ -213,7 +226,8 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
     r.vertices = static_cast<int>(c.num_vertices());
     r.bones = static_cast<int>(c.num_bones());
     if (loss) {
-      r.values["loss"] = (*loss)(train::loss_inputs(c, weights, loss->priors())).item<double>();
+      r.values["loss"] =
+          (*loss)(train::loss_inputs(c, network_weights, loss->priors())).item<double>();
     }
     MetricInputs mi;
     mi.pred = weights;

@@ -113,8 +113,9 @@ Prediction EigenPredictor::predict(const geometry::Character& character,
   const auto start = std::chrono::steady_clock::now();
   data::RowMatrixXf candidates = forward(network_, input.prepared, distance_);
   if (times != nullptr) times->network += seconds_since(start);
+  const std::string prior_outside = network_.keep_prior_outside() ? network_.prior() : "";
   return finish_prediction(std::move(input), distance_, std::move(candidates), options.prune,
-                           times);
+                           prior_outside, times);
 }
 
 }  // namespace skinlab::infer

@@ -647,6 +647,7 @@ struct Network::Impl {
   std::string prior;  ///< empty: the model reads none
   bool prior_bias = false;
   float prior_epsilon = 0;
+  bool keep_prior_outside = false;
   double distance_unit = 1.0 / 88.0, min_distance = 1.0;
   std::vector<std::unique_ptr<Op>> stem, local;
   std::unique_ptr<Op> global;
@@ -661,6 +662,7 @@ Network::~Network() = default;
 
 int Network::top_k() const { return static_cast<int>(impl_->top_k); }
 const std::string& Network::prior() const { return impl_->prior; }
+bool Network::keep_prior_outside() const { return impl_->keep_prior_outside; }
 
 Network Network::from(const ParameterFile& parameters, const fs::path& file) {
 #if defined(__AVX2__) && defined(__FMA__)
@@ -685,6 +687,10 @@ Network Network::from(const ParameterFile& parameters, const fs::path& file) {
       s.fail("architecture: prior must name a binder and prior_epsilon be positive");
     }
     impl->prior_epsilon = static_cast<float>(epsilon);
+    // Parameter files written before keep_prior_outside existed do not have it: false.
+    if (arch.contains("keep_prior_outside")) {
+      impl->keep_prior_outside = s.value<bool>(arch, "keep_prior_outside", "the architecture");
+    }
   }
   impl->top_k = s.value<Index>(arch, "top_k", "the architecture");
   impl->distance_unit = s.value<double>(arch, "distance_unit", "the architecture");

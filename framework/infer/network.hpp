@@ -78,6 +78,9 @@ class Network {
   int top_k() const;
   /// The prior the model reads (a binder's registry key, e.g. "bone_heat"); empty: none.
   const std::string& prior() const;
+  /// Whether predictions keep the prior's weight off the candidates
+  /// (models::PriorOptions::keep_prior_outside, infer::keep_prior_outside); false without a prior.
+  bool keep_prior_outside() const;
 
   Network(Network&&) noexcept;
   Network& operator=(Network&&) noexcept;

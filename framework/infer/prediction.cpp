@@ -168,8 +168,37 @@ PreparedInput prepare_to_predict(const geometry::Character& character,
   return input;
 }
 
+void keep_prior_outside(data::RowMatrixXd& W, const data::PreparedCharacter& character,
+                        const std::string& distance, const std::string& prior) {
+  const auto it = character.priors.find(prior);
+  if (it == character.priors.end()) {
+    throw Error(fmt::format("{}: keep_prior_outside needs the '{}' prior, which the character "
+                            "was not prepared with (preprocess.priors: [{{type: {}}}])",
+                            character.name, prior, prior));
+  }
+  const data::RowMatrixXf& P = it->second;
+  const data::RowMatrixXi& topk = character.distances.at(distance).topk_index;
+  if (P.rows() != W.rows() || P.cols() != W.cols() || topk.rows() != W.rows()) {
+    throw Error(fmt::format("{}: the '{}' prior is {}×{} and its candidates {}×{}, the bone "
+                            "weights {}×{}",
+                            character.name, prior, P.rows(), P.cols(), topk.rows(), topk.cols(),
+                            W.rows(), W.cols()));
+  }
+  for (Eigen::Index v = 0; v < W.rows(); ++v) {
+    double mass = 0;  // m_v: the prior's weight on v's candidates
+    for (Eigen::Index k = 0; k < topk.cols(); ++k) mass += P(v, topk(v, k));
+    Eigen::RowVectorXd row = P.row(v).cast<double>();
+    for (Eigen::Index k = 0; k < topk.cols(); ++k) {
+      const Eigen::Index b = topk(v, k);
+      row(b) = mass * W(v, b);
+    }
+    W.row(v) = row;
+  }
+}
+
 Prediction finish_prediction(PreparedInput input, const std::string& distance,
-                             data::RowMatrixXf candidates, double prune, StageTimes* times) {
+                             data::RowMatrixXf candidates, double prune,
+                             const std::string& prior_outside, StageTimes* times) {
   const auto start = Clock::now();
   const data::PreparedCharacter& prepared = input.prepared;
   const data::DistanceData& d = prepared.distances.at(distance);
@@ -193,6 +222,7 @@ Prediction finish_prediction(PreparedInput input, const std::string& distance,
       W(v, d.topk_index(v, k)) = w;
     }
   }
+  if (!prior_outside.empty()) keep_prior_outside(W, prepared, distance, prior_outside);
   if (times != nullptr) times->network += seconds_since(start);
   Prediction out = finish_bone_weights(std::move(input), distance, std::move(W), prune,
                                        "the network", times);

@@ -119,13 +119,30 @@ PreparedInput prepare_to_predict(const geometry::Character& character,
                                  const Preparation& preparation, const PredictOptions& options,
                                  StageTimes* times = nullptr);
 
+/// A model's distribution over the K candidates completed with a prior's weight on the other
+/// bones (models::PriorOptions::keep_prior_outside; not in the papers). `W` (#V×#B) holds the
+/// distribution scattered to bones: row v is nonzero only on v's candidates C(v) (`character`'s
+/// `distance` top-K) and sums to 1. With P = `character`'s prior `prior` (#V×#B, rows summing
+/// to 1) and m_v = Σ_{b ∈ C(v)} P[v, b], row v becomes
+///
+///     W'[v, b] = m_v · W[v, b]   for b ∈ C(v),      W'[v, b] = P[v, b]   otherwise,
+///
+/// which still sums to 1. The candidates keep the prior's total mass on them, split as the model
+/// predicts; the weight HeterSkinNet's top-K candidates (Sec. 3.2) cannot express stays the
+/// prior's. For W = P renormalised over C(v) (a zero head with the prior's logit bias) W' = P.
+/// Throws Error naming the character when it has no such prior or its shapes differ.
+void keep_prior_outside(data::RowMatrixXd& W, const data::PreparedCharacter& character,
+                        const std::string& distance, const std::string& prior);
+
 /// Step 4: `candidates` (#V×K, the network's softmax over `input.prepared`'s candidates of
-/// `distance`) scattered to bones, pruned, checked (every vertex keeps a weight) and mapped
-/// back to the input's vertices and joints; `input.prepared` moves into the result. Throws
-/// Error naming the character and the vertex for a non-finite or negative output or a vertex
-/// left without weight. `times->map_back` receives the mapping back.
+/// `distance`) scattered to bones, completed with the prior `prior_outside` off the candidates
+/// when that is not empty (keep_prior_outside), pruned, checked (every vertex keeps a weight)
+/// and mapped back to the input's vertices and joints; `input.prepared` moves into the result.
+/// Throws Error naming the character and the vertex for a non-finite or negative output or a
+/// vertex left without weight. `times->map_back` receives the mapping back.
 Prediction finish_prediction(PreparedInput input, const std::string& distance,
                              data::RowMatrixXf candidates, double prune,
+                             const std::string& prior_outside = "",
                              StageTimes* times = nullptr);
 
 /// Step 4 for weights that are already per bone: `W` (#V×#B at `input.prepared`'s vertices,

@@ -26,8 +26,17 @@ void PriorOptions::read(config::Fields& f) {
   f.optional("prior", prior);
   f.optional("prior_bias", prior_bias);
   f.optional("prior_epsilon", prior_epsilon);
+  f.optional("keep_prior_outside", keep_prior_outside);
   f.check(prior_epsilon > 0, "prior_epsilon", "must be positive");
   f.check(!prior_bias || !prior.empty() || !bias_given, "prior_bias", "needs a `prior`");
+  f.check(!keep_prior_outside || !prior.empty(), "keep_prior_outside", "needs a `prior`");
+}
+
+PriorOptions PriorOptions::of(const config::Node& model) {
+  PriorOptions prior;
+  config::Fields fields(model, "model " + model["type"].as<std::string>());
+  prior.read(fields);
+  return prior;
 }
 
 void BranchedModelOptions::fill_missing_branches(const char* defaults_yaml) {

@@ -51,10 +51,20 @@ struct PriorOptions {
   std::string prior;         ///< a key of CharacterTensors::priors; empty: none (the papers)
   bool prior_bias = true;    ///< add log(p + prior_epsilon) to the logits (needs `prior`)
   double prior_epsilon = 1e-3;
+  /// Evaluation and prediction only (training fits the distribution over the candidates, as
+  /// without it): keep the prior's own weight on the bones outside the K candidates and give
+  /// the candidates the prior's mass on them, split as the model predicts
+  /// (infer::keep_prior_outside). With `prior_bias`, a head of zeros then reproduces the prior
+  /// itself instead of the prior renormalised over the candidates. Needs `prior`.
+  bool keep_prior_outside = false;
 
-  /// Reads and checks `prior`, `prior_bias` and `prior_epsilon` from `f` (call before
-  /// `f.finish()`): ConfigError for prior_epsilon ≤ 0 or a `prior_bias` without a `prior`.
+  /// Reads and checks `prior`, `prior_bias`, `prior_epsilon` and `keep_prior_outside` from `f`
+  /// (call before `f.finish()`): ConfigError for prior_epsilon ≤ 0, or a `prior_bias` or
+  /// `keep_prior_outside` without a `prior`.
   void read(config::Fields& f);
+  /// The prior options of the model config node `model` (`{type: ..., prior: ..., ...}`; a
+  /// model that reads no prior gives the defaults with an empty `prior`), checked as by read.
+  static PriorOptions of(const config::Node& model);
 };
 
 /// #V×K: 1 / max(D / distance_unit, min_distance) of the candidates' distances (#V×K metres).

@@ -55,15 +55,6 @@ Json describe(const graph::GraphOp& op) {
 
 }  // namespace
 
-models::PriorOptions model_prior_options(const train::RunOptions& run) {
-  models::PriorOptions prior;
-  config::Fields fields(run.model, "model " + run.model["type"].as<std::string>());
-  prior.read(fields);
-  return prior;
-}
-
-std::string model_prior(const train::RunOptions& run) { return model_prior_options(run).prior; }
-
 infer::ParameterFile parameter_file(const models::Model& model, const train::RunOptions& run,
                                     const std::string& source) {
   infer::ParameterFile p;
@@ -79,10 +70,11 @@ infer::ParameterFile parameter_file(const models::Model& model, const train::Run
   a["top_k"] = options.top_k;
   a["distance_unit"] = options.distance_unit;
   a["min_distance"] = options.min_distance;
-  if (const models::PriorOptions prior = model_prior_options(run); !prior.prior.empty()) {
+  if (const models::PriorOptions prior = models::PriorOptions::of(run.model); !prior.prior.empty()) {
     a["prior"] = prior.prior;
     a["prior_bias"] = prior.prior_bias;
     a["prior_epsilon"] = prior.prior_epsilon;
+    a["keep_prior_outside"] = prior.keep_prior_outside;
   }
   for (const auto& child : model.named_children()) {
     if (const auto* sequence = dynamic_cast<const graph::Sequence*>(child.value().get())) {

@@ -13,7 +13,8 @@
 /// model (graph/mlp.hpp) is listed under `mlps` by module path with its input width, widths and
 /// last activation. `top_k`, `distance_unit` and `min_distance` are the model's options
 /// (models/branched_model.hpp: HeterSkinNet's K and 1/D input, Sec. 3.2 and 4.2); a model
-/// reading a prior adds `prior`, `prior_bias` and `prior_epsilon` (models::PriorOptions).
+/// reading a prior adds `prior`, `prior_bias`, `prior_epsilon` and `keep_prior_outside`
+/// (models::PriorOptions).
 
 #include <filesystem>
 #include <string>
@@ -25,12 +26,6 @@
 
 namespace skinlab::predict {
 
-/// The prior `run`'s model reads (`model.prior`, e.g. "bone_heat"; data/preprocess.hpp step 4b),
-/// empty when it reads none. The parameter file records it; prediction computes only it.
-std::string model_prior(const train::RunOptions& run);
-/// All of the prior's options (models::PriorOptions: prior, prior_bias, prior_epsilon) of
-/// `run`'s model, as the parameter file records them.
-models::PriorOptions model_prior_options(const train::RunOptions& run);
 
 /// The parameter file of `model` (built from `run`'s config); `source` is its provenance.
 infer::ParameterFile parameter_file(const models::Model& model, const train::RunOptions& run,

@@ -19,6 +19,7 @@
 #include "framework/eval/weights.hpp"
 #include "framework/infer/model_dir.hpp"
 #include "framework/geometry/weightless_leaves.hpp"
+#include "framework/models/branched_model.hpp"
 #include "framework/models/model.hpp"
 #include "framework/predict/parameter_export.hpp"
 #include "framework/train/checkpoint.hpp"
@@ -52,8 +53,10 @@ Predictor Predictor::load(const fs::path& dir, const std::string& checkpoint) {
     }
   }
 
+  const models::PriorOptions prior = models::PriorOptions::of(p.options_.model);
   p.preparation_ = infer::load_preparation(dir, p.options_.data.file, p.options_.data.distance,
-                                           model_prior(p.options_));
+                                           prior.prior);
+  if (prior.keep_prior_outside) p.prior_outside_ = prior.prior;
 
   p.model_ = train::build_model(p.options_);
   const train::TrainingState state = train::load_checkpoint(weights, *p.model_);
@@ -80,7 +83,7 @@ Prediction Predictor::predict(const geometry::Character& character, const Predic
   data::RowMatrixXf output = eval::to_eigen(candidates);
   if (times != nullptr) times->network += seconds_since(start);
   return infer::finish_prediction(std::move(input), distance(), std::move(output), options.prune,
-                                  times);
+                                  prior_outside_, times);
 }
 
 std::map<std::string, double> Predictor::metrics_of(const torch::Tensor& pred,

@@ -14,6 +14,7 @@
 #include "framework/infer/eigen_predictor.hpp"
 #include "framework/infer/network.hpp"
 #include "framework/infer/parameters.hpp"
+#include "framework/infer/prediction.hpp"
 #include "framework/models/model.hpp"
 #include "framework/predict/predictor.hpp"
 #include "framework/tensors/tensors.hpp"
@@ -140,6 +141,60 @@ TEST(Prior, AHeadOfZerosGivesThePriorRenormalisedOverTheCandidates) {
   EXPECT_GT(params(*with_bias), params(*make_model("")));
 }
 
+// #V×#B: `candidates` (#V×K) of `c`'s `distance` scattered to its bones, in doubles.
+data::RowMatrixXd scattered(const data::RowMatrixXf& candidates, const data::PreparedCharacter& c,
+                            const std::string& distance) {
+  const data::RowMatrixXi& topk = c.distances.at(distance).topk_index;
+  data::RowMatrixXd W = data::RowMatrixXd::Zero(candidates.rows(), c.num_bones());
+  for (Eigen::Index v = 0; v < W.rows(); ++v) {
+    for (Eigen::Index k = 0; k < topk.cols(); ++k) W(v, topk(v, k)) = candidates(v, k);
+  }
+  return W;
+}
+
+TEST(Prior, KeptOutsideTheCandidatesAZeroHeadGivesThePriorItself) {
+  const data::PreparedCharacter ch = tube_with_bone_heat(2);
+  const data::RowMatrixXi& topk = ch.distances.at("euclidean").topk_index;
+  const data::RowMatrixXd P = ch.priors.at("bone_heat").cast<double>();
+  const Eigen::Index K = topk.cols();
+  data::RowMatrixXf renormalised(P.rows(), K), uniform(P.rows(), K);
+  Eigen::VectorXd mass(P.rows());  // the prior's weight on each vertex's candidates
+  for (Eigen::Index v = 0; v < P.rows(); ++v) {
+    mass(v) = 0;
+    for (Eigen::Index k = 0; k < K; ++k) mass(v) += P(v, topk(v, k));
+    for (Eigen::Index k = 0; k < K; ++k) {
+      renormalised(v, k) = static_cast<float>(P(v, topk(v, k)) / mass(v));
+      uniform(v, k) = 1.0f / static_cast<float>(K);
+    }
+  }
+  // The test means something only if the prior puts weight off some vertex's candidates.
+  ASSERT_LT(mass.minCoeff(), 0.99);
+  ASSERT_GT(mass.minCoeff(), 0.0);
+
+  // The prior renormalised over the candidates (a zero head's output) gives the prior back.
+  data::RowMatrixXd W = scattered(renormalised, ch, "euclidean");
+  infer::keep_prior_outside(W, ch, "euclidean", "bone_heat");
+  EXPECT_LT((W - P).cwiseAbs().maxCoeff(), 1e-6);
+
+  // Any other distribution: the candidates share the prior's mass on them as it says, the other
+  // bones keep the prior's weight, and every row still sums to 1.
+  W = scattered(uniform, ch, "euclidean");
+  infer::keep_prior_outside(W, ch, "euclidean", "bone_heat");
+  for (Eigen::Index v = 0; v < W.rows(); ++v) {
+    EXPECT_NEAR(W.row(v).sum(), 1.0, 1e-6);
+    data::RowMatrixXd expected = P.row(v);
+    for (Eigen::Index k = 0; k < K; ++k) expected(0, topk(v, k)) = mass(v) / static_cast<double>(K);
+    EXPECT_LT((W.row(v) - expected).cwiseAbs().maxCoeff(), 1e-6) << "vertex " << v;
+  }
+
+  // A character without that prior names both.
+  W = scattered(uniform, ch, "euclidean");
+  expect_error<Error>([&] { infer::keep_prior_outside(W, ch, "euclidean", "geo_voxel"); },
+                      {ch.name, "'geo_voxel' prior", "preprocess.priors"});
+  expect_error<ConfigError>([&] { make_model("keep_prior_outside: true, "); },
+                            {"keep_prior_outside", "prior"});
+}
+
 TEST(Prior, AModelReadingAPriorTheCharacterLacksNamesBoth) {
   const auto model = make_model("prior: bone_heat, ");
   const data::CharacterTensors c = data::to_tensors(testing::prepared_tube(0), "euclidean");
@@ -230,10 +285,11 @@ TEST(Prior, TrainsAndPredictsWithTheRunsPreparationInLibtorchAndEigen) {
   data::write_dataset(dir / "tubes.h5", d);
   const config::Config config = config::Config::parse(
       "experiment: prior\nseed: 3\nresults_dir: " + (dir / "results").string() +
-      "\nmodel: " + tiny_heterskinnet("prior: bone_heat, ") +
+      "\nmodel: " + tiny_heterskinnet("prior: bone_heat, keep_prior_outside: true, ") +
       // the anchor to the prior (losses/prior_kl.hpp) runs through training and validation too
       "\nlosses: [{type: soft_cross_entropy, weight: 1.0}, {type: prior_kl, prior: bone_heat, "
       "weight: 0.5}]\n"
+      "metrics: [{type: avg_l1, prune: 0}]\n"
       "data: {file: " + (dir / "tubes.h5").string() + ", split: random, distance: euclidean}\n"
       "train: {epochs: 2, lr: 1.0e-3, patience: 0, log_every: 0}\n");
   train::Trainer trainer(config);
@@ -260,6 +316,26 @@ TEST(Prior, TrainsAndPredictsWithTheRunsPreparationInLibtorchAndEigen) {
   ASSERT_EQ(e.candidates.rows(), p.candidates.rows());
   ASSERT_EQ(e.candidates.cols(), p.candidates.cols());
   EXPECT_LE((e.candidates - p.candidates).cwiseAbs().maxCoeff(), 1e-5);
+
+  // keep_prior_outside: both keep the prior off the candidates, as infer::keep_prior_outside
+  // does to the network's output (unpruned here, so nothing else changes the weights).
+  EXPECT_EQ(file.architecture.at("keep_prior_outside"), true);
+  predict::PredictOptions unpruned;
+  unpruned.prune = 0;
+  const predict::Prediction p0 = predictor.predict(testing::tube_character(5).character, unpruned);
+  const predict::Prediction e0 = eigen.predict(testing::tube_character(5).character, unpruned);
+  data::RowMatrixXd completed = scattered(p0.candidates, p0.prepared, "euclidean");
+  infer::keep_prior_outside(completed, p0.prepared, "euclidean", "bone_heat");
+  EXPECT_LE((p0.prepared_weights.cast<double>() - completed).cwiseAbs().maxCoeff(), 1e-6);
+  EXPECT_LE((e0.prepared_weights - p0.prepared_weights).cwiseAbs().maxCoeff(), 1e-5);
+  EXPECT_GT((completed - scattered(p0.candidates, p0.prepared, "euclidean")).cwiseAbs().maxCoeff(),
+            1e-3);
+  // Evaluation too; the loss is the network's own (over the candidates), so it does not change.
+  const eval::EvalReport kept = eval::evaluate(run, {"val", "best", false, {}});
+  const eval::EvalReport dropped =
+      eval::evaluate(run, {"val", "best", false, {"model.keep_prior_outside=false"}});
+  EXPECT_DOUBLE_EQ(kept.mean.at("loss"), dropped.mean.at("loss"));
+  EXPECT_GT(std::abs(kept.mean.at("avg_l1") - dropped.mean.at("avg_l1")), 1e-4);
   // The prior moves the answer: the same network with a zero prior gives other weights.
   data::PreparedCharacter without = e.prepared;
   without.priors.at("bone_heat").setZero();
