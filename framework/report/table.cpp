@@ -477,6 +477,9 @@ std::string make_split_table(const std::vector<RunResult>& runs, const TableOpti
   }
   const bool union_column = columns.size() > 1;
   const std::string& reference = labels.front();
+  // What the columns are: the test sets, or the validation (or training) sets for --part val.
+  const std::string& part = runs.front().part;
+  const std::string set = (part == "val" ? "validation" : part) + " set";
   auto find_cell = [&](const std::string& label, std::size_t col) -> const Row* {
     const auto at = cells.find({label, col});
     return at == cells.end() ? nullptr : &at->second;
@@ -509,7 +512,7 @@ std::string make_split_table(const std::vector<RunResult>& runs, const TableOpti
     const eval::ValueDisplay display = eval::value_display(m);
     std::vector<std::vector<std::string>> table{{display.column_header()}};
     for (const auto& c : columns) table.front().push_back(c.name);
-    if (union_column) table.front().push_back("all test sets");
+    if (union_column) table.front().push_back("all " + set + "s");
     auto cell_text = [&](const std::vector<double>& values, const std::vector<double>& ref_values,
                          bool is_reference) {
       std::string text = value_text(stats_of(values).mean, display);
@@ -556,13 +559,13 @@ std::string make_split_table(const std::vector<RunResult>& runs, const TableOpti
   if (options.format == "tex") out += "\\end{table}\n";
   if (md) {
     const std::string& unit = runs.front().unit;
-    out += "\nMean over each test set's " + unit;
+    out += "\nMean over each " + set + "'s " + unit;
     if (options.group_runs) {
       out += " (a method with several runs, e.g. seeds: of each " + singular(unit) +
              "'s mean over its runs)";
     }
     out += "; (p …; paired …): two-sided p of the one-way ANOVA (the paper's test, Sec. 4.5) and "
-           "of the paired t-test over the same " + unit + " against " + reference + ". Test sets: ";
+           "of the paired t-test over the same " + unit + " against " + reference + ". The " + set + "s: ";
     for (std::size_t col = 0; col < columns.size(); ++col) {
       const RunResult& r = *column_ref[col];
       out += fmt::format("{}{}: {} {}{}, {} part of split '{}' of `{}`", col ? "; " : "",

@@ -238,6 +238,18 @@ TEST(Table, AcrossSplitsHasAColumnPerTestSetAndTheirUnion) {
             std::string::npos) << md;
   EXPECT_NE(md.find("| third | — | 70.00% (p 0.4226; paired 0.5000) | — |"), std::string::npos) << md;
   EXPECT_NE(md.find("leave_out_y: 2 characters, test part of split 'leave_out_y'"), std::string::npos) << md;
+  EXPECT_NE(md.find("Mean over each test set's characters"), std::string::npos) << md;
+
+  // The validation parts (--part val) are validation sets, and the table says so.
+  std::vector<report::RunResult> val = runs;
+  for (auto& r : val) r.part = "val";
+  const std::string val_md = report::make_table(val, o);
+  EXPECT_NE(val_md.find("| Precision ↑ | leave_out_x | leave_out_y | all validation sets |"),
+            std::string::npos) << val_md;
+  EXPECT_NE(val_md.find("Mean over each validation set's characters"), std::string::npos) << val_md;
+  EXPECT_NE(val_md.find("The validation sets: leave_out_x: 2 characters, val part of split"),
+            std::string::npos) << val_md;
+  EXPECT_EQ(val_md.find("test set"), std::string::npos) << val_md;
 
   // two runs of one method on one test set need --group-runs; a test set's methods must share
   // its characters
