@@ -151,10 +151,7 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
     }
   } else {
     model = train::build_model(o);
-    if (const models::PriorOptions prior = models::PriorOptions::of(o.model);
-        prior.keep_prior_outside) {
-      prior_outside = prior.prior;
-    }
+    prior_outside = models::PriorOptions::of(o.model).outside();
     epoch = train::load_checkpoint(checkpoint, *model).epoch;
     loss = std::make_unique<losses::LossSum>(losses::LossSum::from(o.losses));
     model->eval();

@@ -58,6 +58,10 @@ struct PriorOptions {
   /// itself instead of the prior renormalised over the candidates. Needs `prior`.
   bool keep_prior_outside = false;
 
+  /// The prior whose weight off the candidates evaluation and prediction keep: `prior` with
+  /// keep_prior_outside, else empty (infer::finish_prediction's `prior_outside`).
+  std::string outside() const { return keep_prior_outside ? prior : std::string(); }
+
   /// Reads and checks `prior`, `prior_bias`, `prior_epsilon` and `keep_prior_outside` from `f`
   /// (call before `f.finish()`): ConfigError for prior_epsilon ≤ 0, or a `prior_bias` or
   /// `keep_prior_outside` without a `prior`.

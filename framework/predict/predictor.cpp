@@ -56,7 +56,7 @@ Predictor Predictor::load(const fs::path& dir, const std::string& checkpoint) {
   const models::PriorOptions prior = models::PriorOptions::of(p.options_.model);
   p.preparation_ = infer::load_preparation(dir, p.options_.data.file, p.options_.data.distance,
                                            prior.prior);
-  if (prior.keep_prior_outside) p.prior_outside_ = prior.prior;
+  p.prior_outside_ = prior.outside();
 
   p.model_ = train::build_model(p.options_);
   const train::TrainingState state = train::load_checkpoint(weights, *p.model_);
