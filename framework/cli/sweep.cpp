@@ -9,6 +9,7 @@
 ///     overrides: [data.file=...]        # applied to every entry, before its own
 ///     predictions: false                # write predictions/ for every run (default false)
 ///     metrics: [precision, recall, avg_l1, deformation_error]  # table columns
+///     group_runs: true                  # runs of one experiment (seeds) form one row (default false)
 ///     out: results/tables/table4.md     # the table (Markdown); table4.csv is written beside it
 ///     runs:                             # the first is the reference of the ANOVA columns
 ///       - configs/heterskinnet.yaml
@@ -29,6 +30,11 @@
 /// the run, so results are never mixed. Like `skinlab train` and `skinlab eval`, a sweep holds
 /// an entry's `train.lock` while training it and `eval_<part>.lock` while evaluating it
 /// (core/output_lock.hpp), so a sweep and another process never write the same run at once.
+///
+/// `--table-only` trains and evaluates nothing: the table is written from the entries already
+/// evaluated (`eval_<part>.json` in their run directories, with the config the entry resolves
+/// to now), and the others are named under it as not yet run. This is how a sweep's table is
+/// brought up to date while some of its runs are still training elsewhere or not started.
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -70,6 +76,7 @@ struct Sweep {
   std::vector<std::string> overrides;
   std::vector<std::string> metrics = report::TableOptions{}.metrics;
   bool predictions = false;
+  bool group_runs = false;  ///< report::TableOptions::group_runs
   std::vector<Entry> runs;  ///< after `each` is expanded
 
   /// `each`: every `config:` entry once per value, `override` with {} replaced by the value.
@@ -114,6 +121,7 @@ struct Sweep {
     f.optional("overrides", s.overrides);
     f.optional("metrics", s.metrics);
     f.optional("predictions", s.predictions);
+    f.optional("group_runs", s.group_runs);
     const config::Node runs = f.section("runs");
     const config::Node each = f.section("each");
     f.finish();
@@ -141,6 +149,30 @@ struct Sweep {
   }
 };
 
+/// An entry's config with the sweep's overrides and then its own.
+config::Config entry_config(const Sweep& sweep, const Entry& entry) {
+  std::vector<std::string> overrides = sweep.overrides;
+  overrides.insert(overrides.end(), entry.overrides.begin(), entry.overrides.end());
+  return config::Config::load(entry.config, overrides);
+}
+
+/// An entry's run directory: `run:` itself, else <results_dir>/<experiment>/<run id>.
+fs::path entry_dir(const Sweep& sweep, const Entry& entry) {
+  if (!entry.run.empty()) return entry.run;
+  const auto o = train::RunOptions::from(entry_config(sweep, entry));
+  return fs::path(o.results_dir) / o.experiment / (entry.run_id.empty() ? sweep.name : entry.run_id);
+}
+
+/// Error unless the run directory `dir`, if it exists, was made with `config` (so a sweep never
+/// mixes the results of another config into its table).
+void require_same_config(const fs::path& dir, const config::Config& config, const Entry& entry) {
+  if (!fs::exists(dir)) return;
+  if (read_file(dir / "config.yaml") != config.to_yaml()) {
+    throw Error(dir.string() + ": exists with another config than " + entry.config +
+                " resolves to now; move it away or rename the sweep");
+  }
+}
+
 /// Trains or opens the run of one entry and evaluates it; returns its run directory.
 fs::path run_entry(const Sweep& sweep, const Entry& entry, int threads) {
   if (!entry.run.empty()) {
@@ -157,24 +189,16 @@ fs::path run_entry(const Sweep& sweep, const Entry& entry, int threads) {
     }
     return run.path();
   }
-  std::vector<std::string> overrides = sweep.overrides;
-  overrides.insert(overrides.end(), entry.overrides.begin(), entry.overrides.end());
-  const config::Config config = config::Config::load(entry.config, overrides);
+  const config::Config config = entry_config(sweep, entry);
   const train::RunOptions o = train::RunOptions::from(config);
   const bool binder = task::get(o.task).untrained(config, o);
   if (!binder) o.require_training_sections(config);
   set_torch_threads(threads >= 0 ? threads : o.threads);
 
   const std::string run_id = entry.run_id.empty() ? sweep.name : entry.run_id;
-  const fs::path dir = fs::path(o.results_dir) / o.experiment / run_id;
+  const fs::path dir = entry_dir(sweep, entry);
   const bool existed = fs::exists(dir);
-  if (existed) {
-    const std::string saved = read_file(dir / "config.yaml");
-    if (saved != config.to_yaml()) {
-      throw Error(dir.string() + ": exists with another config than " + entry.config +
-                  " resolves to now; move it away or rename the sweep");
-    }
-  }
+  require_same_config(dir, config, entry);
   // An untrained method (binder, baseline) whose run has its evaluation is not evaluated again:
   // the same config gives the same values, and its dataset need not be on this machine.
   if (existed && binder && fs::exists(dir / ("eval_" + sweep.part + ".json"))) {
@@ -227,12 +251,16 @@ Command add_sweep(CLI::App& app) {
   struct Args {
     std::string file;
     int threads = -1;
+    bool table_only = false;
   };
   auto args = std::make_shared<Args>();
   cmd->add_option("file", args->file, "sweep file (YAML), e.g. configs/sweeps/table4.yaml")
       ->required();
   cmd->add_option("--threads", args->threads,
                   "libtorch threads for every entry (default: each config's `threads`)");
+  cmd->add_flag("--table-only", args->table_only,
+                "train and evaluate nothing: the table of the entries already evaluated, the "
+                "others named under it as not yet run");
   return {cmd, [args] {
             const Sweep sweep = Sweep::from(config::Config::load(args->file));
             // Every entry's config must load before anything trains, and no two entries may
@@ -243,11 +271,7 @@ Command add_sweep(CLI::App& app) {
                 RunDir::open(entry.run);  // must exist
                 continue;
               }
-              std::vector<std::string> overrides = sweep.overrides;
-              overrides.insert(overrides.end(), entry.overrides.begin(), entry.overrides.end());
-              const auto o = train::RunOptions::from(config::Config::load(entry.config, overrides));
-              const fs::path dir = fs::path(o.results_dir) / o.experiment /
-                                   (entry.run_id.empty() ? sweep.name : entry.run_id);
+              const fs::path dir = entry_dir(sweep, entry);
               if (!dirs.emplace(dir, entry.config).second) {
                 throw Error(args->file + ": " + entry.config + " and " + dirs[dir] +
                             " would share the run directory " + dir.string() +
@@ -255,15 +279,39 @@ Command add_sweep(CLI::App& app) {
               }
             }
             std::vector<report::RunResult> results;
+            std::vector<std::string> not_run;  // --table-only: entries without an evaluation
             for (const auto& entry : sweep.runs) {
-              results.push_back(report::load_run_result(run_entry(sweep, entry, args->threads),
-                                                        sweep.part));
+              if (!args->table_only) {
+                results.push_back(report::load_run_result(run_entry(sweep, entry, args->threads),
+                                                          sweep.part));
+                continue;
+              }
+              const fs::path dir = entry_dir(sweep, entry);
+              if (entry.run.empty()) require_same_config(dir, entry_config(sweep, entry), entry);
+              if (fs::exists(dir / ("eval_" + sweep.part + ".json"))) {
+                results.push_back(report::load_run_result(dir, sweep.part));
+              } else {
+                not_run.push_back(dir.string());
+              }
+            }
+            if (results.empty()) {
+              throw Error(args->file + ": no entry has been evaluated on the " + sweep.part +
+                          " part yet (eval_" + sweep.part + ".json); run the sweep without "
+                          "--table-only");
             }
             report::TableOptions t;
             t.metrics = sweep.metrics;
             t.title = sweep.title;
-            t.command = "skinlab sweep " + args->file;
-            const std::string md = task::table_text(results, t);
+            t.group_runs = sweep.group_runs;
+            t.command = "skinlab sweep " + args->file + (args->table_only ? " --table-only" : "");
+            std::string md = task::table_text(results, t);
+            if (!not_run.empty()) {
+              md += "\nNot yet run or evaluated (`skinlab sweep " + args->file + "` runs them): ";
+              for (std::size_t i = 0; i < not_run.size(); ++i) {
+                md += (i ? ", `" : "`") + not_run[i] + "`";
+              }
+              md += ".\n";
+            }
             t.format = "csv";
             const fs::path out = sweep.out;
             if (out.has_parent_path()) fs::create_directories(out.parent_path());

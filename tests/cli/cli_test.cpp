@@ -407,6 +407,40 @@ TEST(Cli, SmokeRunPrepareTrainEvalOnTheBundledSubset) {
   EXPECT_NE(read_file(std::filesystem::path(results) / "smoke" / "ea-4" / "config.yaml")
                 .find("seed: 4\n"),
             std::string::npos);
+  // --table-only trains nothing: the table of the entries already evaluated, the others named
+  // under it as not yet run; with none evaluated it is an error.
+  const auto overrides = "overrides: [data.file=" + data + ", results_dir=" + results +
+                         ", train.epochs=1]\n";
+  const auto partial = dir.write(
+      "partial.yaml", "name: sw\nout: " + (dir / "tables" / "partial.md").string() + "\n" +
+                          overrides + "runs:\n  - configs/smoke.yaml\n"
+                          "  - {config: configs/smoke.yaml, overrides: [seed=2], run_id: sw-seed2}\n");
+  const Result po = run("sweep " + partial.string() + " --table-only");
+  ASSERT_EQ(po.status, 0) << po.err;
+  const std::string partial_table = read_file(dir / "tables" / "partial.md");
+  EXPECT_TRUE(has_row(partial_table, "smoke", "sw")) << partial_table;
+  EXPECT_FALSE(has_row(partial_table, "smoke", "sw-seed2")) << partial_table;
+  EXPECT_NE(partial_table.find("Not yet run or evaluated"), std::string::npos) << partial_table;
+  EXPECT_NE(partial_table.find("sw-seed2`."), std::string::npos) << partial_table;
+  EXPECT_NE(partial_table.find("--table-only"), std::string::npos) << partial_table;
+  EXPECT_FALSE(std::filesystem::exists(std::filesystem::path(results) / "smoke" / "sw-seed2"));
+  // group_runs: the runs of one experiment (seeds) form one row.
+  const auto grouped = dir.write(
+      "grouped.yaml", "name: sw\nout: " + (dir / "tables" / "grouped.md").string() +
+                          "\ngroup_runs: true\n" + overrides + "runs:\n  - configs/smoke.yaml\n"
+                          "  - {config: configs/smoke.yaml, overrides: [seed=1], run_id: sw-seed1}\n");
+  const Result gr = run("sweep " + grouped.string() + " --table-only");
+  ASSERT_EQ(gr.status, 0) << gr.err;
+  const std::string grouped_table = read_file(dir / "tables" / "grouped.md");
+  const auto row = grouped_table.find("| smoke | sw");
+  ASSERT_NE(row, std::string::npos) << grouped_table;
+  const std::string line = grouped_table.substr(row, grouped_table.find('\n', row) - row);
+  EXPECT_NE(line.find(", sw-seed1"), std::string::npos) << grouped_table;
+  const auto none = dir.write("none.yaml", "name: none\nout: x.md\n" + overrides +
+                                               "runs: [configs/smoke.yaml]\n");
+  const Result no = run("sweep " + none.string() + " --table-only");
+  EXPECT_EQ(no.status, 1);
+  EXPECT_NE(no.err.find("no entry has been evaluated on the test part"), std::string::npos) << no.err;
   const auto bad_each = dir.write(
       "bad_each.yaml", "name: b\nout: x.md\neach: {override: 'seed=1', values: [3]}\n"
                        "runs: [configs/smoke.yaml]\n");
