@@ -42,7 +42,6 @@
 #include <filesystem>
 #include <iostream>
 #include <map>
-#include <optional>
 
 #include "framework/tensors/threads.hpp"
 #include "framework/cli/commands.hpp"
@@ -156,11 +155,15 @@ config::Config entry_config(const Sweep& sweep, const Entry& entry) {
   return config::Config::load(entry.config, overrides);
 }
 
-/// An entry's run directory: `run:` itself, else <results_dir>/<experiment>/<run id>.
-fs::path entry_dir(const Sweep& sweep, const Entry& entry) {
-  if (!entry.run.empty()) return entry.run;
-  const auto o = train::RunOptions::from(entry_config(sweep, entry));
-  return fs::path(o.results_dir) / o.experiment / (entry.run_id.empty() ? sweep.name : entry.run_id);
+/// A `config:` entry's run id: its own, else the sweep's name.
+std::string run_id_of(const Sweep& sweep, const Entry& entry) {
+  return entry.run_id.empty() ? sweep.name : entry.run_id;
+}
+
+/// The run directory of a `config:` entry whose resolved config gave `o`:
+/// <results_dir>/<experiment>/<run id>.
+fs::path run_dir_of(const train::RunOptions& o, const Sweep& sweep, const Entry& entry) {
+  return fs::path(o.results_dir) / o.experiment / run_id_of(sweep, entry);
 }
 
 /// Error unless the run directory `dir`, if it exists, was made with `config` (so a sweep never
@@ -195,8 +198,7 @@ fs::path run_entry(const Sweep& sweep, const Entry& entry, int threads) {
   if (!binder) o.require_training_sections(config);
   set_torch_threads(threads >= 0 ? threads : o.threads);
 
-  const std::string run_id = entry.run_id.empty() ? sweep.name : entry.run_id;
-  const fs::path dir = entry_dir(sweep, entry);
+  const fs::path dir = run_dir_of(o, sweep, entry);
   const bool existed = fs::exists(dir);
   require_same_config(dir, config, entry);
   // An untrained method (binder, baseline) whose run has its evaluation is not evaluated again:
@@ -222,25 +224,24 @@ fs::path run_entry(const Sweep& sweep, const Entry& entry, int threads) {
   }
   std::cout << fmt::format("== {} ({}) → {}\n", entry.config, binder ? "evaluate only" : "train",
                            dir.string());
-  std::optional<RunDir> run;
-  if (!binder) {
-    const std::unique_ptr<task::TaskTrainer> trainer = task::make_trainer(config);
-    run = existed ? RunDir::open(dir) : train::create_run(config, o, run_id, command_line());
-    const OutputLock lock(train_lock_of(run->path()), run->path().string(), command_line());
-    const train::TrainResult r = trainer->fit(*run, {});
+  // The trainer is made (its config checked) before a new run directory is.
+  const std::unique_ptr<task::TaskTrainer> trainer = binder ? nullptr : task::make_trainer(config);
+  const RunDir run = existed ? RunDir::open(dir)
+                             : train::create_run(config, o, run_id_of(sweep, entry), command_line());
+  if (trainer) {
+    const OutputLock lock(train_lock_of(run.path()), run.path().string(), command_line());
+    const train::TrainResult r = trainer->fit(run, {});
     spdlog::info("{}: {} epochs, best epoch {} (validation loss {:.6g})", o.experiment, r.epochs,
                  r.best_epoch, r.best_loss);
-  } else {
-    run = existed ? RunDir::open(dir) : train::create_run(config, o, run_id, command_line());
   }
   eval::EvalOptions e;
   e.part = sweep.part;
   e.predictions = sweep.predictions;
-  const OutputLock lock(eval_lock_of(run->path(), e.part),
-                        run->file("eval_" + e.part + ".json").string(), command_line());
-  const eval::EvalReport report = task::evaluate_run(*run, e);
+  const OutputLock lock(eval_lock_of(run.path(), e.part),
+                        run.file("eval_" + e.part + ".json").string(), command_line());
+  const eval::EvalReport report = task::evaluate_run(run, e);
   std::cout << fmt::format("   {} characters, {:.1f} s\n", report.characters.size(), report.seconds);
-  return run->path();
+  return run.path();
 }
 
 }  // namespace
@@ -271,7 +272,8 @@ Command add_sweep(CLI::App& app) {
                 RunDir::open(entry.run);  // must exist
                 continue;
               }
-              const fs::path dir = entry_dir(sweep, entry);
+              const fs::path dir =
+                  run_dir_of(train::RunOptions::from(entry_config(sweep, entry)), sweep, entry);
               if (!dirs.emplace(dir, entry.config).second) {
                 throw Error(args->file + ": " + entry.config + " and " + dirs[dir] +
                             " would share the run directory " + dir.string() +
@@ -286,8 +288,12 @@ Command add_sweep(CLI::App& app) {
                                                           sweep.part));
                 continue;
               }
-              const fs::path dir = entry_dir(sweep, entry);
-              if (entry.run.empty()) require_same_config(dir, entry_config(sweep, entry), entry);
+              fs::path dir = entry.run;
+              if (entry.run.empty()) {
+                const config::Config config = entry_config(sweep, entry);
+                dir = run_dir_of(train::RunOptions::from(config), sweep, entry);
+                require_same_config(dir, config, entry);
+              }
               if (fs::exists(dir / ("eval_" + sweep.part + ".json"))) {
                 results.push_back(report::load_run_result(dir, sweep.part));
               } else {
@@ -306,11 +312,8 @@ Command add_sweep(CLI::App& app) {
             t.command = "skinlab sweep " + args->file + (args->table_only ? " --table-only" : "");
             std::string md = task::table_text(results, t);
             if (!not_run.empty()) {
-              md += "\nNot yet run or evaluated (`skinlab sweep " + args->file + "` runs them): ";
-              for (std::size_t i = 0; i < not_run.size(); ++i) {
-                md += (i ? ", `" : "`") + not_run[i] + "`";
-              }
-              md += ".\n";
+              md += fmt::format("\nNot yet run or evaluated (`skinlab sweep {}` runs them): `{}`.\n",
+                                args->file, fmt::join(not_run, "`, `"));
             }
             t.format = "csv";
             const fs::path out = sweep.out;
