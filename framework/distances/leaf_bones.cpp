@@ -2,9 +2,13 @@
 
 #include "framework/distances/triangle_tree.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <numeric>
 #include <optional>
+#include <utility>
 #include <vector>
 
 namespace skinlab::distances {
@@ -31,11 +35,59 @@ LeafBoneOptions::Kind parse_kind(const config::Node& node) {
   node.fail("expected 'helper' (the paper's zero-length bone) or 'extended', got '" + name + "'");
 }
 
+/// The connected part (component over shared vertex indices) of every face of `mesh`.
+std::vector<int> face_parts(const geometry::Mesh& mesh) {
+  std::vector<int> parent(static_cast<std::size_t>(mesh.num_vertices()));
+  std::iota(parent.begin(), parent.end(), 0);
+  const auto find = [&](int v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    for (int k = 1; k < 3; ++k) parent[find(mesh.F(f, k))] = find(mesh.F(f, 0));
+  }
+  std::vector<int> part(static_cast<std::size_t>(mesh.num_faces()));
+  for (int f = 0; f < mesh.num_faces(); ++f) part[f] = find(mesh.F(f, 0));
+  return part;
+}
+
+/// Where the ray from a leaf ends, from its crossings (distance along the ray, face):
+/// `first_surface` the nearest; `enclosing_parts` the largest nearest crossing over the parts
+/// crossed an odd number of times, or the nearest when there is none (leaf_bones.hpp). A ray
+/// through an edge or a vertex meets every triangle there at the same distance: crossings of one
+/// part closer than `coincident` count once.
+double ray_end(std::vector<std::pair<double, int>> crossings, const std::vector<int>& part,
+               LeafBoneOptions::End ends_at, double coincident) {
+  std::sort(crossings.begin(), crossings.end());
+  const double first = crossings.front().first;
+  if (ends_at == LeafBoneOptions::End::kFirstSurface) return first;
+  struct Crossed {
+    int count = 0;        // distinct crossings
+    double nearest = 0;   // the part's first crossing
+    double last = 0;      // the latest one counted
+  };
+  std::map<int, Crossed> parts;
+  for (const auto& [t, face] : crossings) {  // in order of distance
+    Crossed& c = parts[part[face]];
+    if (c.count == 0) c.nearest = t;
+    if (c.count == 0 || t - c.last > coincident) ++c.count;
+    c.last = t;
+  }
+  double end = -1;
+  for (const auto& [p, c] : parts) {
+    if (c.count % 2 == 1) end = std::max(end, c.nearest);
+  }
+  return end >= 0 ? end : first;
+}
+
 /// The `extended` construction (leaf_bones.hpp) on a validated mesh and skeleton.
 Eigen::MatrixXd tips_by_rays(const geometry::Mesh& mesh, const geometry::Skeleton& skeleton,
-                             double max_length, double coincident) {
+                             double max_length, double coincident, LeafBoneOptions::End ends_at) {
   const aabb::TriangleTree triangles(mesh);
   const Tree& tree = triangles.tree();
+  const std::vector<int> part = ends_at == LeafBoneOptions::End::kEnclosingParts
+                                    ? face_parts(mesh)
+                                    : std::vector<int>{};
 
   Eigen::MatrixXd tips = skeleton.positions;
   const auto children = skeleton.children();
@@ -53,22 +105,25 @@ Eigen::MatrixXd tips_by_rays(const geometry::Mesh& mesh, const geometry::Skeleto
 
     std::vector<Tree::Intersection_and_primitive_id<Ray>::Type> hits;
     tree.all_intersections(Ray(point(leaf), point(leaf + d)), std::back_inserter(hits));
-    double first = std::numeric_limits<double>::infinity();
+    std::vector<std::pair<double, int>> crossings;  // (distance along the ray, mesh face)
     for (const auto& hit : hits) {
       // A ray meets a triangle in a point, or in a segment when it runs in the triangle's plane
-      // (then its nearer end counts).
+      // (then its nearer end ahead of the joint counts, once).
+      double t = std::numeric_limits<double>::infinity();
       if (const Point* p = boost::get<Point>(&hit.first)) {
-        const double t = (vec(*p) - leaf).dot(d);
-        if (t > coincident) first = std::min(first, t);
+        const double at = (vec(*p) - leaf).dot(d);
+        if (at > coincident) t = at;
       } else if (const Kernel::Segment_3* s = boost::get<Kernel::Segment_3>(&hit.first)) {
         for (const Point& q : {s->source(), s->target()}) {
-          const double t = (vec(q) - leaf).dot(d);
-          if (t > coincident) first = std::min(first, t);
+          const double at = (vec(q) - leaf).dot(d);
+          if (at > coincident) t = std::min(t, at);
         }
       }
+      if (std::isfinite(t)) crossings.emplace_back(t, triangles.face(hit.second));
     }
-    if (!std::isfinite(first)) continue;  // nothing ahead: the joint is outside, facing away
-    tips.row(j) = (leaf + std::min(first, max_length * parent_length) * d).transpose();
+    if (crossings.empty()) continue;  // nothing ahead: the joint is outside, facing away
+    const double end = ray_end(std::move(crossings), part, ends_at, coincident);
+    tips.row(j) = (leaf + std::min(end, max_length * parent_length) * d).transpose();
   }
   return tips;
 }
@@ -88,6 +143,11 @@ LeafBoneOptions LeafBoneOptions::from(const config::Node& node) {
   o.kind = leaf_geometry::parse_kind(node["type"]);
   f.optional("max_length", o.max_length);
   f.check(o.max_length > 0, "max_length", "must be positive");
+  std::string ends_at = "first_surface";
+  f.optional("ends_at", ends_at)
+      .check(ends_at == "first_surface" || ends_at == "enclosing_parts", "ends_at",
+             "must be 'first_surface' or 'enclosing_parts', got '" + ends_at + "'");
+  if (ends_at == "enclosing_parts") o.ends_at = LeafBoneOptions::End::kEnclosingParts;
   f.finish();
   return o;
 }
@@ -97,7 +157,8 @@ std::string LeafBoneOptions::name() const {
 }
 
 Eigen::MatrixXd extended_leaf_tips(const geometry::Mesh& mesh, const geometry::Skeleton& skeleton,
-                                   double max_length, const std::string& source) {
+                                   double max_length, const std::string& source,
+                                   LeafBoneOptions::End ends_at) {
   mesh.validate(source);
   skeleton.validate(source);
   if (!(max_length > 0)) {
@@ -107,7 +168,7 @@ Eigen::MatrixXd extended_leaf_tips(const geometry::Mesh& mesh, const geometry::S
   const double scale = (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).norm();
   const double coincident = leaf_geometry::kCoincident * std::max(scale, 1.0);
 
-  return leaf_geometry::tips_by_rays(mesh, skeleton, max_length, coincident);
+  return leaf_geometry::tips_by_rays(mesh, skeleton, max_length, coincident, ends_at);
 }
 
 void place_leaf_bones(const geometry::Mesh& mesh, geometry::Skeleton& skeleton,
@@ -116,7 +177,8 @@ void place_leaf_bones(const geometry::Mesh& mesh, geometry::Skeleton& skeleton,
     skeleton.leaf_tips.resize(0, 0);
     return;
   }
-  skeleton.leaf_tips = extended_leaf_tips(mesh, skeleton, options.max_length, source);
+  skeleton.leaf_tips =
+      extended_leaf_tips(mesh, skeleton, options.max_length, source, options.ends_at);
 }
 
 }  // namespace skinlab::distances

@@ -33,6 +33,20 @@
 /// The foot is its weak case: the ray along the shin meets the sole soon, so the foot's bone is
 /// short; it still separates the foot from the end of the shin.
 ///
+/// **Where the ray ends** (`ends_at`). `first_surface` (the default, every prepared dataset
+/// before 2026-12-06): t* is the nearest crossing of any triangle. Game characters are often
+/// several closed parts that overlap (a head pushed onto a body whose neck is capped), and then
+/// the first surface ahead is the other part's cap, not the end of the leaf's region: on the
+/// KayKit adventurers the head's bone ended 2.5-8.5 mm above the head joint (0.3-0.4 m of head
+/// above it).
+/// `enclosing_parts`: the ray ends where it leaves the last of the parts that enclose the leaf
+/// joint. A part is a connected component of the mesh's triangles (shared vertex indices); it
+/// encloses the joint when the ray crosses it an odd number of times (the parity test of a closed
+/// surface); t* is the largest, over the enclosing parts, of the part's nearest crossing. Caps
+/// and shells of parts that do not enclose the joint no longer stop the ray. When no part
+/// encloses the joint (an open mesh, a joint outside), the nearest crossing is kept. Measured
+/// with per-joint bone heat on every test set: results/tables/leaf_bones_enclosing_bone_heat.md.
+///
 /// The result is Skeleton::leaf_tips; bones, their order and the bone-level targets do not
 /// change (a leaf's weight is its helper bone's, data/preprocess.hpp), only the geometry that
 /// distances, binders and the bone attribute (Sec. 3.2) see.
@@ -50,9 +64,12 @@ struct LeafBoneOptions {
   enum class Kind { kHelper, kExtended };
   Kind kind = Kind::kHelper;  ///< `helper` (the paper) or `extended` (this file's comment)
   double max_length = 1.0;    ///< bound of an extended bone, × the parent bone's length; > 0
+  enum class End { kFirstSurface, kEnclosingParts };
+  End ends_at = End::kFirstSurface;  ///< where the ray ends (this file's comment)
 
   /// Decodes `leaf_bones: helper` / `leaf_bones: extended` or the map
-  /// `{type: extended, max_length: 1.0}`; errors name the config file, line and key.
+  /// `{type: extended, max_length: 1.0, ends_at: enclosing_parts}`; errors name the config
+  /// file, line and key.
   static LeafBoneOptions from(const config::Node& node);
   /// "helper" or "extended".
   std::string name() const;
@@ -62,8 +79,10 @@ struct LeafBoneOptions {
 /// of leaf joint j, and the joint's own position for every joint with children. Both in the same
 /// frame and units. Throws GeometryError (prefixed by `source`) for an invalid mesh or skeleton
 /// or `max_length` ≤ 0.
-Eigen::MatrixXd extended_leaf_tips(const geometry::Mesh& mesh, const geometry::Skeleton& skeleton,
-                                   double max_length, const std::string& source);
+Eigen::MatrixXd extended_leaf_tips(
+    const geometry::Mesh& mesh, const geometry::Skeleton& skeleton, double max_length,
+    const std::string& source,
+    LeafBoneOptions::End ends_at = LeafBoneOptions::End::kFirstSurface);
 
 /// Sets `skeleton.leaf_tips` as `options` asks: cleared for `helper`, extended_leaf_tips(...)
 /// for `extended`.

@@ -31,10 +31,13 @@ class TriangleTree {
  public:
   explicit TriangleTree(const geometry::Mesh& mesh) {
     triangles_.reserve(static_cast<std::size_t>(mesh.num_faces()));
+    faces_.reserve(static_cast<std::size_t>(mesh.num_faces()));
     const auto point = [&](int v) { return Point(mesh.V(v, 0), mesh.V(v, 1), mesh.V(v, 2)); };
     for (int f = 0; f < mesh.num_faces(); ++f) {
       Triangle t(point(mesh.F(f, 0)), point(mesh.F(f, 1)), point(mesh.F(f, 2)));
-      if (!t.is_degenerate()) triangles_.push_back(t);
+      if (t.is_degenerate()) continue;
+      triangles_.push_back(t);
+      faces_.push_back(f);
     }
     tree_.insert(triangles_.cbegin(), triangles_.cend());
     tree_.build();
@@ -43,9 +46,14 @@ class TriangleTree {
   TriangleTree& operator=(const TriangleTree&) = delete;
 
   const Tree& tree() const { return tree_; }
+  /// The mesh face (row of Mesh::F) of a primitive a query returned.
+  int face(TriangleIterator primitive) const {
+    return faces_[static_cast<std::size_t>(primitive - triangles_.cbegin())];
+  }
 
  private:
   std::vector<Triangle> triangles_;
+  std::vector<int> faces_;  // mesh face of each triangle
   Tree tree_;
 };
 

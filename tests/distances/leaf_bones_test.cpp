@@ -7,6 +7,7 @@
 #include "framework/core/registry.hpp"
 #include "framework/distances/distance.hpp"
 #include "framework/distances/leaf_bones.hpp"
+#include "framework/geometry/merge_vertices.hpp"
 #include "tests/distances/shapes.hpp"
 #include "tests/test_util.hpp"
 
@@ -65,6 +66,46 @@ TEST(LeafBones, CoincidentParentUsesTheNextAncestorsDirection) {
   EXPECT_NEAR(tips(2, 1), 4.0, 1e-9);
 }
 
+/// The column's chain in two closed parts that overlap, as a game head pushed onto a capped body:
+/// a body box up to y = 2.6, just above the leaf (2.5), and a head box from y = 2 to 4 around
+/// it; a third box from y = 4.5 to 5 above both encloses nothing. Co-located vertices merged,
+/// as preprocessing does, so each box is one part.
+struct HeadOnBody : Column {
+  HeadOnBody() {
+    mesh = geometry::merge_vertices(testing::MeshBuilder()
+                                        .box({-0.5, 0, -0.5}, {0.5, 2.6, 0.5}, 3)
+                                        .box({-0.4, 2, -0.4}, {0.4, 4, 0.4}, 3)
+                                        .box({-0.3, 4.5, -0.3}, {0.3, 5, 0.3}, 2)
+                                        .build(),
+                                    {1e-9})
+               .mesh;
+  }
+};
+
+TEST(LeafBones, EnclosingPartsEndsWhereTheRayLeavesTheLastPartAroundTheLeaf) {
+  HeadOnBody c;
+  using End = LeafBoneOptions::End;
+  // The first surface ahead is the body's cap, 0.1 above the leaf.
+  EXPECT_NEAR(extended_leaf_tips(c.mesh, c.skeleton, 3.0, "h", End::kFirstSurface)(2, 1), 2.6,
+              1e-9);
+  // Both the body (crossed once) and the head (once) enclose the leaf; the head is left last, at
+  // its top. The box above, crossed twice, encloses nothing and does not count.
+  EXPECT_NEAR(extended_leaf_tips(c.mesh, c.skeleton, 3.0, "h", End::kEnclosingParts)(2, 1), 4.0,
+              1e-9);
+  // Still bounded by max_length × the parent's length (1).
+  EXPECT_NEAR(extended_leaf_tips(c.mesh, c.skeleton, 0.75, "h", End::kEnclosingParts)(2, 1),
+              3.25, 1e-12);
+  // A leaf below the top box, outside every part: no enclosing part, so the nearest surface.
+  c.skeleton.positions(2, 1) = 4.2;
+  EXPECT_NEAR(extended_leaf_tips(c.mesh, c.skeleton, 3.0, "h", End::kEnclosingParts)(2, 1), 4.5,
+              1e-9);
+  // place_leaf_bones reads the option.
+  place_leaf_bones(c.mesh, c.skeleton,
+                   parse("leaf_bones: {type: extended, max_length: 3, ends_at: enclosing_parts}"),
+                   "h");
+  EXPECT_NEAR(c.skeleton.leaf_tips(2, 1), 4.5, 1e-9);
+}
+
 TEST(LeafBones, SkeletonSegmentsUseTheTipsAndHelperClearsThem) {
   Column c;
   place_leaf_bones(c.mesh, c.skeleton, parse("leaf_bones: extended"), "column");
@@ -97,6 +138,11 @@ TEST(LeafBones, Options) {
   EXPECT_EQ(o.kind, LeafBoneOptions::Kind::kExtended);
   EXPECT_DOUBLE_EQ(o.max_length, 0.5);
   EXPECT_EQ(o.name(), "extended");
+  EXPECT_EQ(o.ends_at, LeafBoneOptions::End::kFirstSurface);  // absent: every earlier dataset
+  EXPECT_EQ(parse("leaf_bones: {type: extended, ends_at: enclosing_parts}").ends_at,
+            LeafBoneOptions::End::kEnclosingParts);
+  expect_error<ConfigError>([] { parse("leaf_bones: {type: extended, ends_at: last}"); },
+                            {"ends_at", "'first_surface'", "'enclosing_parts'", "last"});
   expect_error<ConfigError>([] { parse("leaf_bones: longer"); },
                                     {"p.yaml:1", "leaf_bones", "'helper'", "'extended'", "longer"});
   expect_error<ConfigError>([] { parse("leaf_bones: {type: extended, max_length: 0}"); },
