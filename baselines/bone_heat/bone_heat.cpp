@@ -9,13 +9,13 @@
 #include <cstdint>
 #include <iterator>
 #include <limits>
-#include <numeric>
 #include <unordered_map>
 #include <vector>
 
 #include "framework/core/registry.hpp"
 #include "framework/distances/triangle_tree.hpp"
 #include "framework/geometry/closest_point_on_segment.hpp"
+#include "framework/geometry/mesh_parts.hpp"
 #include "framework/geometry/orient_outward.hpp"
 
 namespace skinlab::baselines {
@@ -247,16 +247,8 @@ Eigen::MatrixXd BoneHeat::bind(const geometry::Mesh& input, const geometry::Skel
     }
   }
 
-  // Components over non-degenerate triangles (union-find).
-  std::vector<int> parent(nv);
-  std::iota(parent.begin(), parent.end(), 0);
-  const auto find = [&](int v) {
-    while (parent[v] != v) v = parent[v] = parent[parent[v]];
-    return v;
-  };
-  for (int f : good_faces) {
-    for (int k = 1; k < 3; ++k) parent[find(mesh.F(f, k))] = find(mesh.F(f, 0));
-  }
+  // Components over non-degenerate triangles.
+  const std::vector<int> part = geometry::vertex_parts(mesh, good_faces);
 
   // ---- distances, visibility, H and p ---------------------------------------------------------
   const auto visible = [&](int v, const Eigen::Vector3d& target) {
@@ -321,7 +313,7 @@ Eigen::MatrixXd BoneHeat::bind(const geometry::Mesh& input, const geometry::Skel
   // ---- which vertices are solved, which fall back --------------------------------------------
   std::vector<char> component_heated(nv, 0);
   for (int v = 0; v < nv; ++v) {
-    if (H[v] > 0) component_heated[find(v)] = 1;
+    if (H[v] > 0) component_heated[part[v]] = 1;
     if (H[v] == 0) ++st.invisible_vertices;
   }
   std::vector<int> active_index(nv, -1);
@@ -329,7 +321,7 @@ Eigen::MatrixXd BoneHeat::bind(const geometry::Mesh& input, const geometry::Skel
   std::vector<char> fallback(nv, 0);
   std::vector<char> counted_component(nv, 0);
   for (int v = 0; v < nv; ++v) {
-    const int c = find(v);
+    const int c = part[v];
     if (area[v] > 0 && component_heated[c]) {
       active_index[v] = static_cast<int>(active.size());
       active.push_back(v);

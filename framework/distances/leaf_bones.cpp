@@ -1,12 +1,12 @@
 #include "framework/distances/leaf_bones.hpp"
 
 #include "framework/distances/triangle_tree.hpp"
+#include "framework/geometry/mesh_parts.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
-#include <numeric>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -35,29 +35,13 @@ LeafBoneOptions::Kind parse_kind(const config::Node& node) {
   node.fail("expected 'helper' (the paper's zero-length bone) or 'extended', got '" + name + "'");
 }
 
-/// The connected part (component over shared vertex indices) of every face of `mesh`.
-std::vector<int> face_parts(const geometry::Mesh& mesh) {
-  std::vector<int> parent(static_cast<std::size_t>(mesh.num_vertices()));
-  std::iota(parent.begin(), parent.end(), 0);
-  const auto find = [&](int v) {
-    while (parent[v] != v) v = parent[v] = parent[parent[v]];
-    return v;
-  };
-  for (int f = 0; f < mesh.num_faces(); ++f) {
-    for (int k = 1; k < 3; ++k) parent[find(mesh.F(f, k))] = find(mesh.F(f, 0));
-  }
-  std::vector<int> part(static_cast<std::size_t>(mesh.num_faces()));
-  for (int f = 0; f < mesh.num_faces(); ++f) part[f] = find(mesh.F(f, 0));
-  return part;
-}
-
-/// Where the ray from a leaf ends, from its crossings (distance along the ray, face):
+/// Where the ray from a leaf ends, from its crossings (distance along the ray, mesh part):
 /// `first_surface` the nearest; `enclosing_parts` the largest nearest crossing over the parts
 /// crossed an odd number of times, or the nearest when there is none (leaf_bones.hpp). A ray
 /// through an edge or a vertex meets every triangle there at the same distance: crossings of one
 /// part closer than `coincident` count once.
-double ray_end(std::vector<std::pair<double, int>> crossings, const std::vector<int>& part,
-               LeafBoneOptions::End ends_at, double coincident) {
+double ray_end(std::vector<std::pair<double, int>> crossings, LeafBoneOptions::End ends_at,
+               double coincident) {
   std::sort(crossings.begin(), crossings.end());
   const double first = crossings.front().first;
   if (ends_at == LeafBoneOptions::End::kFirstSurface) return first;
@@ -67,8 +51,8 @@ double ray_end(std::vector<std::pair<double, int>> crossings, const std::vector<
     double last = 0;      // the latest one counted
   };
   std::map<int, Crossed> parts;
-  for (const auto& [t, face] : crossings) {  // in order of distance
-    Crossed& c = parts[part[face]];
+  for (const auto& [t, part] : crossings) {  // in order of distance
+    Crossed& c = parts[part];
     if (c.count == 0) c.nearest = t;
     if (c.count == 0 || t - c.last > coincident) ++c.count;
     c.last = t;
@@ -86,8 +70,8 @@ Eigen::MatrixXd tips_by_rays(const geometry::Mesh& mesh, const geometry::Skeleto
   const aabb::TriangleTree triangles(mesh);
   const Tree& tree = triangles.tree();
   const std::vector<int> part = ends_at == LeafBoneOptions::End::kEnclosingParts
-                                    ? face_parts(mesh)
-                                    : std::vector<int>{};
+                                    ? geometry::vertex_parts(mesh)
+                                    : std::vector<int>{};  // unused by first_surface
 
   Eigen::MatrixXd tips = skeleton.positions;
   const auto children = skeleton.children();
@@ -105,7 +89,7 @@ Eigen::MatrixXd tips_by_rays(const geometry::Mesh& mesh, const geometry::Skeleto
 
     std::vector<Tree::Intersection_and_primitive_id<Ray>::Type> hits;
     tree.all_intersections(Ray(point(leaf), point(leaf + d)), std::back_inserter(hits));
-    std::vector<std::pair<double, int>> crossings;  // (distance along the ray, mesh face)
+    std::vector<std::pair<double, int>> crossings;  // (distance along the ray, mesh part)
     for (const auto& hit : hits) {
       // A ray meets a triangle in a point, or in a segment when it runs in the triangle's plane
       // (then its nearer end ahead of the joint counts, once).
@@ -119,10 +103,11 @@ Eigen::MatrixXd tips_by_rays(const geometry::Mesh& mesh, const geometry::Skeleto
           if (at > coincident) t = std::min(t, at);
         }
       }
-      if (std::isfinite(t)) crossings.emplace_back(t, triangles.face(hit.second));
+      if (!std::isfinite(t)) continue;
+      crossings.emplace_back(t, part.empty() ? 0 : part[mesh.F(triangles.face(hit.second), 0)]);
     }
     if (crossings.empty()) continue;  // nothing ahead: the joint is outside, facing away
-    const double end = ray_end(std::move(crossings), part, ends_at, coincident);
+    const double end = ray_end(std::move(crossings), ends_at, coincident);
     tips.row(j) = (leaf + std::min(end, max_length * parent_length) * d).transpose();
   }
   return tips;
