@@ -21,6 +21,12 @@
 ///     h_v = l_v ‖ l_b[n_v,1] ‖ … ‖ l_b[n_v,K] ‖ G    # bones scattered to their vertices
 ///     w_v = softmax(MLP_head(h_v))                    # [1024, 512, K], 50 % dropout
 ///
+/// A character with fewer bones than K has only that many candidates (data/preprocess.hpp); its
+/// candidates (index, distance, prior) are padded to K with the nearest one again, and the padded
+/// slots' logits are dropped before the softmax, so w_v is a distribution over its own candidates
+/// (#V × its K). infer/network.cpp does the same for `skinlab-predict`. Not in the paper, whose
+/// characters all have more than K = 3 bones.
+///
 /// `stem`, `local` (lists of ops, graph/graph_op.hpp) and `global` (one op) are config nodes;
 /// their defaults are the paper's widths (vertex local 256, bone local 128, global 512 + 512).
 /// Mesh-edge dropout (85 % of one-ring and geodesic edges, Sec. 4.2, graph/edge_dropout.hpp) is

@@ -722,13 +722,44 @@ Network Network::from(const ParameterFile& parameters, const fs::path& file) {
   return Network(std::move(impl));
 }
 
-std::vector<float> Network::forward(const NetworkInput& c) const {
+namespace {
+
+/// The #V×k_own row-major `own` with its first column repeated until it has `k` columns.
+template <typename T>
+std::vector<T> repeat_nearest(const T* own, Index nv, Index k_own, Index k) {
+  std::vector<T> out(static_cast<std::size_t>(nv * k));
+  for (Index v = 0; v < nv; ++v)
+    for (Index j = 0; j < k; ++j) out[v * k + j] = own[v * k_own + (j < k_own ? j : 0)];
+  return out;
+}
+
+}  // namespace
+
+std::vector<float> Network::forward(const NetworkInput& character) const {
   const Impl& n = *impl_;
-  const Index nv = c.num_vertices, nb = c.num_bones;
-  if (c.top_k != n.top_k) {
-    throw Error(fmt::format("{}: {} candidate bones per vertex, but the model was built for "
-                            "K = {}",
-                            c.name, c.top_k, n.top_k));
+  const Index nv = character.num_vertices, nb = character.num_bones;
+  // As the libtorch model (experiments/heterskinnet/heterskinnet.cpp): a character with fewer
+  // bones than K has that many candidates; they are padded with the nearest one again and the
+  // padded slots are dropped before the softmax.
+  const Index k_own = character.top_k;
+  if (k_own != n.top_k && !(k_own >= 1 && k_own < n.top_k && k_own == nb)) {
+    throw Error(fmt::format("{}: {} candidate bones per vertex and {} bones, but the model was "
+                            "built for K = {}",
+                            character.name, k_own, nb, n.top_k));
+  }
+  NetworkInput c = character;
+  std::vector<int> padded_index;
+  std::vector<float> padded_distance, padded_prior;
+  if (k_own < n.top_k) {
+    padded_index = repeat_nearest(character.topk_index, nv, k_own, n.top_k);
+    padded_distance = repeat_nearest(character.topk_distance, nv, k_own, n.top_k);
+    c.topk_index = padded_index.data();
+    c.topk_distance = padded_distance.data();
+    if (character.prior != nullptr) {
+      padded_prior = repeat_nearest(character.prior, nv, k_own, n.top_k);
+      c.prior = padded_prior.data();
+    }
+    c.top_k = n.top_k;
   }
   if (nv < 1 || nb < 1) {
     throw Error(fmt::format("{}: {} vertices and {} bones; the network needs both", c.name, nv,
@@ -789,6 +820,7 @@ std::vector<float> Network::forward(const NetworkInput& c) const {
   const Features l = run(n.local, std::move(x), g);
   Matrix out = n.head.forward(l.vertex, l.bone, topk, shared);
   if (prior_inputs > 0 && n.prior_bias) out.array() += (prior.array() + n.prior_epsilon).log();
+  if (k_own < n.top_k) out = Matrix(out.leftCols(k_own));
   softmax_rows(out);
   return std::vector<float>(out.data(), out.data() + out.size());
 }

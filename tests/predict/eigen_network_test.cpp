@@ -96,21 +96,29 @@ losses: [{type: kl}]
 data: {file: unused.h5, split: random, distance: euclidean}
 )";
 
-TEST(EigenNetwork, EveryOpPathEqualsLibtorch) {
-  const train::RunOptions options = train::RunOptions::from(config::Config::parse(kConfig));
+/// The random network of kConfig built for `model_k` candidates, and the player prepared with
+/// `prepared_k` (fewer when the player has fewer bones): libtorch's weights and the Eigen
+/// network's through the parameter file.
+struct BothPaths {
+  data::PreparedCharacter prepared;
+  data::RowMatrixXf libtorch, eigen;
+};
+
+BothPaths both_paths(int model_k, int prepared_k) {
+  std::string yaml = kConfig;
+  yaml.replace(yaml.find("top_k: 3"), 8, "top_k: " + std::to_string(model_k));
+  const train::RunOptions options = train::RunOptions::from(config::Config::parse(yaml));
   const auto model = train::build_model(options);
   model->eval();
   const infer::Preparation preparation = infer::parse_preparation(
-      "preprocess: {top_k: 3}\ndistances: [{type: euclidean}]\n", "preparation.yaml", ".",
-      "euclidean");
+      "preprocess: {top_k: " + std::to_string(prepared_k) + "}\ndistances: [{type: euclidean}]\n",
+      "preparation.yaml", ".", "euclidean");
   const geometry::Character character = geometry::import_character(kPlayer);
-  const data::PreparedCharacter prepared =
-      infer::prepare_to_predict(character, preparation, {}).prepared;
-
-  data::RowMatrixXf expected;
+  BothPaths out;
+  out.prepared = infer::prepare_to_predict(character, preparation, {}).prepared;
   {
     torch::NoGradGuard no_grad;
-    expected = eval::to_eigen(model->forward(data::to_tensors(prepared, "euclidean")));
+    out.libtorch = eval::to_eigen(model->forward(data::to_tensors(out.prepared, "euclidean")));
   }
   // Through the file, as skinlab-predict reads it.
   TempDir dir;
@@ -123,11 +131,33 @@ TEST(EigenNetwork, EveryOpPathEqualsLibtorch) {
   EXPECT_EQ(parameters.architecture.at("global_branch").at("keep_input"), true);
   EXPECT_EQ(parameters.parameters.size(), model->named_parameters().size());
   const infer::Network network = infer::Network::from(parameters, file);
-  const data::RowMatrixXf got = infer::forward(network, prepared, "euclidean");
-  const double difference = max_difference(expected, got);
+  out.eigen = infer::forward(network, out.prepared, "euclidean");
+  return out;
+}
+
+TEST(EigenNetwork, EveryOpPathEqualsLibtorch) {
+  const BothPaths p = both_paths(3, 3);
+  const double difference = max_difference(p.libtorch, p.eigen);
   EXPECT_LE(difference, 1e-5);
   std::cout << "random network: max |Eigen - libtorch| " << difference << "\n";
-  EXPECT_LE((got.rowwise().sum().array() - 1).abs().maxCoeff(), 1e-5);
+  EXPECT_LE((p.eigen.rowwise().sum().array() - 1).abs().maxCoeff(), 1e-5);
+}
+
+TEST(EigenNetwork, ACharacterWithFewerBonesThanKGetsWeightsOnItsOwnBones) {
+  // K above the player's bone count: it has one candidate per bone, the network pads them to K
+  // with the nearest again and drops the padded slots, in both paths alike.
+  const BothPaths p = both_paths(64, 64);
+  ASSERT_LT(p.prepared.num_bones(), 64);
+  ASSERT_EQ(p.prepared.distances.at("euclidean").topk_index.cols(), p.prepared.num_bones());
+  ASSERT_EQ(p.libtorch.cols(), p.prepared.num_bones());
+  ASSERT_EQ(p.eigen.rows(), p.libtorch.rows());
+  ASSERT_EQ(p.eigen.cols(), p.libtorch.cols());
+  EXPECT_LE(max_difference(p.libtorch, p.eigen), 1e-5);
+  EXPECT_LE((p.eigen.rowwise().sum().array() - 1).abs().maxCoeff(), 1e-5);
+  EXPECT_GE(p.eigen.minCoeff(), 0.0f);
+
+  // Fewer candidates than K on a character that has more bones is a mismatch, not padded.
+  EXPECT_THROW(both_paths(3, 2), c10::Error);
 }
 
 TEST(EigenNetwork, ParameterFileRoundTripsAndIsWrittenWhole) {
