@@ -24,8 +24,8 @@
 /// A character with fewer bones than K has only that many candidates (data/preprocess.hpp); its
 /// candidates (index, distance, prior) are padded to K with the nearest one again, and the padded
 /// slots' logits are dropped before the softmax, so w_v is a distribution over its own candidates
-/// (#V × its K). infer/network.cpp does the same for `skinlab-predict`. Not in the paper, whose
-/// characters all have more than K = 3 bones.
+/// (#V × its K). infer/network.cpp does the same for `skinlab-predict`. Not in the paper: Sec. 3.2
+/// takes the K nearest bones and does not say what a character with fewer bones gets.
 ///
 /// `stem`, `local` (lists of ops, graph/graph_op.hpp) and `global` (one op) are config nodes;
 /// their defaults are the paper's widths (vertex local 256, bone local 128, global 512 + 512).
