@@ -1,6 +1,7 @@
 #include "experiments/heterskinnet/heterskinnet.hpp"
 
 #include "framework/core/registry.hpp"
+#include "framework/tensors/candidates.hpp"
 
 namespace skinlab::experiments {
 
@@ -63,35 +64,13 @@ HeterSkinNet::HeterSkinNet(Options options) : options_(std::move(options)) {
       "head", graph::Mlp(l.vertex + options_.top_k * l.bone + g.vertex, std::move(head)));
 }
 
-namespace {
-
-/// `t` (#V×k) with its first column repeated until it has `k_model` columns.
-torch::Tensor repeat_nearest(const torch::Tensor& t, std::int64_t k_model) {
-  const std::int64_t k = t.size(1);
-  return torch::cat({t, t.narrow(1, 0, 1).expand({t.size(0), k_model - k})}, 1);
-}
-
-}  // namespace
-
 torch::Tensor HeterSkinNet::forward(const data::CharacterTensors& character) {
-  // A character with fewer bones than K has only that many candidates (data/preprocess.hpp): its
-  // candidates are padded with the nearest one again, and the padded slots are dropped from
-  // the head's logits before the softmax, so the weights are a distribution over its own
-  // candidates (#V×its K).
+  // A character with fewer bones than K has only that many candidates: they are padded to K
+  // and the padded slots are dropped from the head's logits before the softmax
+  // (data::candidates_for_model), so the weights are over its own candidates (#V×its K).
   const std::int64_t k_own = character.top_k();
-  TORCH_CHECK(k_own == options_.top_k ||
-                  (k_own < options_.top_k && k_own == character.num_bones()),
-              "heterskinnet: built for top_k = ", options_.top_k, " but character '",
-              character.name, "' has ", k_own, " candidate bones per vertex and ",
-              character.num_bones(), " bones (set model.top_k to the dataset's top_k)");
-  data::CharacterTensors padded;
-  if (k_own < options_.top_k) {
-    padded = character;
-    padded.topk_index = repeat_nearest(character.topk_index, options_.top_k);
-    padded.topk_distance = repeat_nearest(character.topk_distance, options_.top_k);
-    for (auto& [name, prior] : padded.priors) prior = repeat_nearest(prior, options_.top_k);
-  }
-  const data::CharacterTensors& c = k_own < options_.top_k ? padded : character;
+  const data::CharacterTensors c =
+      data::candidates_for_model(character, options_.top_k, "heterskinnet");
   const std::int64_t nv = c.num_vertices(), k = options_.top_k;
   graph::Graph g = graph::make_graph(c);
   if (is_training() && options_.edge_dropout.p > 0) g = graph::drop_edges(g, options_.edge_dropout);
@@ -123,6 +102,7 @@ torch::Tensor HeterSkinNet::forward(const data::CharacterTensors& character) {
   if (prior.defined() && options_.prior_bias) {
     logits = logits + torch::log(prior + options_.prior_epsilon);
   }
+  logits = models::with_leaf_bias(logits, c, options_.leaf_bias, is_training());
   return torch::softmax(logits.narrow(1, 0, k_own), 1);
 }
 

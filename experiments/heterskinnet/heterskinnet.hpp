@@ -21,10 +21,16 @@
 ///     h_v = l_v ‖ l_b[n_v,1] ‖ … ‖ l_b[n_v,K] ‖ G    # bones scattered to their vertices
 ///     w_v = softmax(MLP_head(h_v))                    # [1024, 512, K], 50 % dropout
 ///
+/// Evaluation and prediction may add `leaf_bias` to the logits of the candidates that are a leaf
+/// joint's bone (models::BranchedModelOptions::leaf_bias; not in the paper): a calibration chosen
+/// on the validation part after training, against the network's measured habit of giving a
+/// leaf's region to its parent (experiments/heterskinnet/README.md).
+///
 /// A character with fewer bones than K has only that many candidates (data/preprocess.hpp); its
 /// candidates (index, distance, prior) are padded to K with the nearest one again, and the padded
 /// slots' logits are dropped before the softmax, so w_v is a distribution over its own candidates
-/// (#V × its K). infer/network.cpp does the same for `skinlab-predict`. Not in the paper: Sec. 3.2
+/// (#V × its K; data::candidates_for_model, shared with RigNet's and NeuroSkinning's networks).
+/// infer/network.cpp does the same for `skinlab-predict`. Not in the paper: Sec. 3.2
 /// takes the K nearest bones and does not say what a character with fewer bones gets.
 ///
 /// `stem`, `local` (lists of ops, graph/graph_op.hpp) and `global` (one op) are config nodes;

@@ -7,6 +7,15 @@
 /// `binder:` (weights from geometry alone) needs no training; this creates its run directory
 /// (resolved config, env.json) and evaluates it there.
 ///
+/// `skinlab eval <run_dir> key=value ... --run-id ID`: the run's checkpoint under the overrides,
+/// as a run of its own, `<results_dir>/<experiment>/<ID>` (experiment after the overrides, e.g.
+/// `experiment=..._leaf_bias model.leaf_bias=0.5`): the config with the overrides applied,
+/// env.json, a copy of the source's metrics.jsonl and its checkpoint (`--checkpoint`, a hard link
+/// where the file system allows, else a copy), so `skinlab table` compares it with its source like any two runs. For
+/// settings that act after training only (models::BranchedModelOptions::leaf_bias,
+/// keep_prior_outside, the metrics' pruning); the checkpoint must still load under the
+/// overrides.
+///
 /// `--nproc N` shards the characters of a skinning run over N worker processes on this machine
 /// (core/launch.hpp); rank 0 gathers the values and predictions and writes the files. A process
 /// started with WORLD_SIZE > 1 is one rank of such an evaluation (train/distributed.hpp).
@@ -35,6 +44,7 @@
 #include "framework/core/error.hpp"
 #include "framework/core/launch.hpp"
 #include "framework/core/output_lock.hpp"
+#include "framework/train/checkpoint.hpp"
 #include "framework/train/distributed.hpp"
 #include "framework/train/run_options.hpp"
 #include "framework/train/trainer.hpp"
@@ -69,13 +79,37 @@ RunDir create_binder_run(EvalArgs& args) {
   return run;
 }
 
+/// The run of a trained run's checkpoint under overrides (see the file comment); the overrides
+/// are applied to the saved config, so they are cleared from `args`.
+RunDir derive_run(EvalArgs& args) {
+  namespace fs = std::filesystem;
+  const RunDir source = RunDir::open(args.run);
+  if (args.options.overrides.empty()) {
+    throw Error("eval: --run-id with a trained run (" + args.run +
+                ") makes a run of its checkpoint under overrides, and none were given");
+  }
+  const fs::path checkpoint = train::existing_checkpoint(source.path(), args.options.checkpoint);
+  const config::Config config =
+      config::Config::load(source.file("config.yaml"), args.options.overrides);
+  const train::RunOptions o = train::RunOptions::from(config);
+  RunDir run = train::create_run(config, o, args.run_id, command_line());
+  std::cout << "run: " << run.path().string() << " (the checkpoint of " << args.run << ")\n";
+  const fs::path linked = run.file(checkpoint.filename().string());
+  std::error_code no_link;
+  fs::create_hard_link(checkpoint, linked, no_link);
+  if (no_link) fs::copy_file(checkpoint, linked);
+  if (fs::exists(source.file("metrics.jsonl"))) {
+    fs::copy_file(source.file("metrics.jsonl"), run.file("metrics.jsonl"));
+  }
+  args.options.overrides.clear();
+  return run;
+}
+
 int run_eval(EvalArgs args) {
   const bool from_config = std::filesystem::is_regular_file(args.run);
-  if (!from_config && !args.run_id.empty()) {
-    throw Error("eval: --run-id names the new run of a binder config; " + args.run +
-                " is not a config file");
-  }
-  const RunDir run = from_config ? create_binder_run(args) : RunDir::open(args.run);
+  const RunDir run = from_config        ? create_binder_run(args)
+               : !args.run_id.empty() ? derive_run(args)
+                                      : RunDir::open(args.run);
   std::optional<OutputLock> lock;  // the launcher's workers write under their launcher's lock
   if (std::getenv("SKINLAB_LAUNCHED") == nullptr && train::WorldOptions::from_environment().rank == 0) {
     lock.emplace(eval_lock_of(run.path(), args.options.part),
@@ -128,7 +162,8 @@ Command add_eval(CLI::App& app) {
                   "run directory (results/<experiment>/<run_id>), or the config of a binder")
       ->required();
   cmd->add_option("--run-id", args->run_id,
-                  "name of the new run directory of a binder config (default: the UTC time)");
+                  "name of the new run directory of a binder config (default: the UTC time), or "
+                  "of a trained run's checkpoint evaluated under the overrides");
   cmd->add_option("overrides", args->options.overrides,
                   "key.sub=value assignments applied to the run's config (e.g. data.file=...)");
   cmd->add_option("--split", args->options.part, "part of the configured split: train, val or test")

@@ -648,6 +648,7 @@ struct Network::Impl {
   bool prior_bias = false;
   float prior_epsilon = 0;
   bool keep_prior_outside = false;
+  float leaf_bias = 0;  ///< models::BranchedModelOptions::leaf_bias
   double distance_unit = 1.0 / 88.0, min_distance = 1.0;
   std::vector<std::unique_ptr<Op>> stem, local;
   std::unique_ptr<Op> global;
@@ -695,6 +696,12 @@ Network Network::from(const ParameterFile& parameters, const fs::path& file) {
   impl->top_k = s.value<Index>(arch, "top_k", "the architecture");
   impl->distance_unit = s.value<double>(arch, "distance_unit", "the architecture");
   impl->min_distance = s.value<double>(arch, "min_distance", "the architecture");
+  // Written only when not 0 (and never before leaf_bias existed).
+  if (arch.contains("leaf_bias")) {
+    const auto bias = s.value<double>(arch, "leaf_bias", "the architecture");
+    if (!std::isfinite(bias)) s.fail("architecture: leaf_bias must be finite");
+    impl->leaf_bias = static_cast<float>(bias);
+  }
   if (impl->top_k < 1 || !(impl->distance_unit > 0) || !(impl->min_distance > 0)) {
     s.fail("architecture: top_k, distance_unit and min_distance must be positive");
   }
@@ -820,6 +827,11 @@ std::vector<float> Network::forward(const NetworkInput& character) const {
   const Features l = run(n.local, std::move(x), g);
   Matrix out = n.head.forward(l.vertex, l.bone, topk, shared);
   if (prior_inputs > 0 && n.prior_bias) out.array() += (prior.array() + n.prior_epsilon).log();
+  if (n.leaf_bias != 0) {  // models::with_leaf_bias: on the candidates that are a leaf's bone
+    for (Index v = 0; v < nv; ++v)
+      for (Index j = 0; j < n.top_k; ++j)
+        if (bones(topk(v, j), 0) == bones(topk(v, j), 1)) out(v, j) += n.leaf_bias;
+  }
   if (k_own < n.top_k) out = Matrix(out.leftCols(k_own));
   softmax_rows(out);
   return std::vector<float>(out.data(), out.data() + out.size());

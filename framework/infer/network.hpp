@@ -11,7 +11,9 @@
 ///
 /// and for a model trained with a prior (models::PriorOptions, not in the paper) q_v, a
 /// classical method's weight on the K candidates: f_v = [p ‖ 1/D ‖ q_v] (2K + 3) and, with
-/// `prior_bias`, w_v = softmax(MLP_head(…) + log(q_v + prior_epsilon));
+/// `prior_bias`, w_v = softmax(MLP_head(…) + log(q_v + prior_epsilon)); a `leaf_bias` in the
+/// architecture (models::BranchedModelOptions::leaf_bias) is added to the logits of the
+/// candidates that are a leaf joint's bone before the softmax;
 /// with the graph ops of the libtorch implementation (framework/graph/), each the same map:
 ///   - `b2v` (Eq. 5): MLP(f_v ‖ f_{b_{n_v,1}} ‖ … ‖ f_{b_{n_v,K}}), layer 0 split by weight
 ///     blocks so the bone blocks cost #B rows (graph/mlp.hpp, forward_gathered);

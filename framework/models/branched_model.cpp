@@ -1,7 +1,10 @@
 #include "framework/models/branched_model.hpp"
 
+#include <cmath>
 #include <map>
 #include <mutex>
+
+#include "framework/tensors/candidates.hpp"
 
 namespace skinlab::models {
 
@@ -14,11 +17,13 @@ void BranchedModelOptions::read(config::Fields& f) {
   global = f.section("global");
   f.optional("head", head);
   f.optional("head_dropout", head_dropout);
+  f.optional("leaf_bias", leaf_bias);
   f.check(top_k >= 1, "top_k", "must be ≥ 1");
   f.check(distance_unit > 0, "distance_unit", "must be positive");
   f.check(min_distance > 0, "min_distance", "must be positive");
   for (auto w : head) f.check(w >= 1, "head", "widths must be ≥ 1");
   f.check(head_dropout >= 0 && head_dropout < 1, "head_dropout", "must be in [0, 1)");
+  f.check(std::isfinite(leaf_bias), "leaf_bias", "must be finite");
 }
 
 void PriorOptions::read(config::Fields& f) {
@@ -51,6 +56,19 @@ void BranchedModelOptions::fill_missing_branches(const char* defaults_yaml) {
   if (!stem.exists()) stem = root["stem"];
   if (!local.exists()) local = root["local"];
   if (!global.exists()) global = root["global"];
+}
+
+torch::Tensor leaf_candidates(const data::CharacterTensors& c) {
+  const torch::Tensor leaf_bone = c.bone_joints.select(1, 0) == c.bone_joints.select(1, 1);
+  return leaf_bone.index_select(0, c.topk_index.reshape({-1}))
+      .reshape(c.topk_index.sizes())
+      .to(torch::kFloat32);
+}
+
+torch::Tensor with_leaf_bias(const torch::Tensor& logits, const data::CharacterTensors& c,
+                             double leaf_bias, bool training) {
+  if (training || leaf_bias == 0) return logits;
+  return logits + leaf_bias * leaf_candidates(c);
 }
 
 torch::Tensor inverse_distance(const torch::Tensor& topk_distance,
@@ -104,13 +122,17 @@ BranchedNetwork::BranchedNetwork(std::string name, const BranchedModelOptions& o
                                  const std::vector<std::int64_t>& input_mlp)
     : name_(std::move(name)),
       top_k_(options.top_k),
+      leaf_bias_(options.leaf_bias),
       layers_(*this, name_, options, input_width, input_mlp, 6, options.top_k) {}
 
-torch::Tensor BranchedNetwork::forward(const data::CharacterTensors& c) {
-  TORCH_CHECK(c.top_k() == top_k_, name_, ": built for top_k = ", top_k_, " but character '",
-              c.name, "' has ", c.top_k(),
-              " candidate bones per vertex (set model.top_k to the dataset's top_k)");
-  return torch::softmax(layers_.forward(input_features(c), c.bones, graph::make_graph(c)), 1);
+torch::Tensor BranchedNetwork::forward(const data::CharacterTensors& character) {
+  // A character with fewer bones than K: its candidates padded to K, the padded slots' logits
+  // dropped before the softmax (data::candidates_for_model), as HeterSkinNet does.
+  const data::CharacterTensors c = data::candidates_for_model(character, top_k_, name_);
+  const torch::Tensor logits =
+      with_leaf_bias(layers_.forward(input_features(c), c.bones, graph::make_graph(c)), c,
+                     leaf_bias_, is_training());
+  return torch::softmax(logits.narrow(1, 0, character.top_k()), 1);
 }
 
 }  // namespace skinlab::models

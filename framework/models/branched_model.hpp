@@ -32,6 +32,12 @@ struct BranchedModelOptions {
   config::Node stem, local, global;   ///< op lists / op node; missing: the model's defaults
   std::vector<std::int64_t> head = {1024, 512};  ///< hidden widths before the K logits
   double head_dropout = 0.5;
+  /// Evaluation and prediction only (not in the papers): added to the logit of every candidate
+  /// that is a leaf joint's bone (start joint = end joint; models::leaf_candidates) before the
+  /// softmax, i.e. each leaf candidate's weight multiplied by e^leaf_bias and the row
+  /// renormalised. A calibration chosen on the validation part after training
+  /// (scripts/calibrate_leaf_bias); training never sees it. 0: none.
+  double leaf_bias = 0;
 
   /// Reads and checks these fields from `f` (call before `f.finish()`).
   void read(config::Fields& f);
@@ -70,6 +76,15 @@ struct PriorOptions {
   /// model that reads no prior gives the defaults with an empty `prior`), checked as by read.
   static PriorOptions of(const config::Node& model);
 };
+
+/// #V×K: 1 where candidate k of vertex v is a leaf joint's bone (start joint = end joint of
+/// c.bone_joints: the helper bone at a joint without children), else 0; float32.
+torch::Tensor leaf_candidates(const data::CharacterTensors& c);
+
+/// `logits` (#V×K over c's candidates) with `leaf_bias` (BranchedModelOptions::leaf_bias) added
+/// to the leaf candidates' when `training` is false and leaf_bias is not 0; `logits` otherwise.
+torch::Tensor with_leaf_bias(const torch::Tensor& logits, const data::CharacterTensors& c,
+                             double leaf_bias, bool training);
 
 /// #V×K: 1 / max(D / distance_unit, min_distance) of the candidates' distances (#V×K metres).
 torch::Tensor inverse_distance(const torch::Tensor& topk_distance,
@@ -115,7 +130,8 @@ class BranchedLayers {
 
 class BranchedNetwork : public Model {
  public:
-  /// #V×K softmax over the candidates `c.topk_index`.
+  /// #V×K softmax over the candidates `c.topk_index`; for a character with fewer bones than K,
+  /// over its own candidates (data::candidates_for_model).
   torch::Tensor forward(const data::CharacterTensors& c) override;
   /// The #V×`input_width` features f_v.
   virtual torch::Tensor input_features(const data::CharacterTensors& c) const = 0;
@@ -129,6 +145,7 @@ class BranchedNetwork : public Model {
  private:
   std::string name_;
   std::int64_t top_k_;
+  double leaf_bias_;
   BranchedLayers layers_;
 };
 

@@ -70,6 +70,7 @@ infer::ParameterFile parameter_file(const models::Model& model, const train::Run
   a["top_k"] = options.top_k;
   a["distance_unit"] = options.distance_unit;
   a["min_distance"] = options.min_distance;
+  if (options.leaf_bias != 0) a["leaf_bias"] = options.leaf_bias;
   if (const models::PriorOptions prior = models::PriorOptions::of(run.model); !prior.prior.empty()) {
     a["prior"] = prior.prior;
     a["prior_bias"] = prior.prior_bias;

@@ -116,6 +116,12 @@ TEST(NeuroSkinning, PaperWidthsStartUnsaturated) {
       << "mean largest weight " << top.mean().item<float>();
 }
 
+TEST(NeuroSkinning, ACharacterWithFewerBonesThanKGetsWeightsOnItsOwnBones) {
+  std::string yaml = kTiny;
+  yaml.replace(yaml.find("top_k: 3"), 8, "top_k: 8");
+  testing::expect_own_candidates_below_k(*make(yaml), 8);
+}
+
 TEST(NeuroSkinning, OptionErrorsNameTheField) {
   using testing::expect_error;
   expect_error<ConfigError>([] { make("{type: neuroskinning, input_mlp: [0]}"); }, {"input_mlp"});

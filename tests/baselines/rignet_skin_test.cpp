@@ -186,6 +186,12 @@ TEST(RigNetSkin, RejectsAMismatchedTopK) {
   testing::expect_error<c10::Error>([&] { m->forward(tube(0)); }, {"top_k = 2"});
 }
 
+TEST(RigNetSkin, ACharacterWithFewerBonesThanKGetsWeightsOnItsOwnBones) {
+  std::string yaml = kTiny;
+  yaml.replace(yaml.find("top_k: 3"), 8, "top_k: 8");
+  testing::expect_own_candidates_below_k(*make(yaml), 8);
+}
+
 TEST(RigNetSkin, BadOptionsAreConfigErrorsNamingTheField) {
   using testing::expect_error;
   expect_error<ConfigError>([] { make("type: rignet_skin\nhead_widths: [8]"); }, {"head_widths"});

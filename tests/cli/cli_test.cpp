@@ -339,6 +339,27 @@ TEST(Cli, SmokeRunPrepareTrainEvalOnTheBundledSubset) {
     }
   }
 
+  // The checkpoint under an evaluation-only override as a run of its own (--run-id): its own
+  // config, the same checkpoint and epoch, different weights; without overrides, an error and no
+  // run.
+  const Result d = run("eval " + run_dir.string() +
+                       " experiment=smoke_leaf_bias model.leaf_bias=1.5 --run-id ci --split test");
+  ASSERT_EQ(d.status, 0) << d.err;
+  const std::filesystem::path derived = dir / "results" / "smoke_leaf_bias" / "ci";
+  for (const char* f : {"config.yaml", "env.json", "metrics.jsonl", "best.pt", "eval_test.json"}) {
+    EXPECT_TRUE(std::filesystem::exists(derived / f)) << f;
+  }
+  EXPECT_FALSE(std::filesystem::exists(derived / "last.pt"));
+  EXPECT_NE(read_file(derived / "config.yaml").find("leaf_bias: 1.5"), std::string::npos);
+  EXPECT_EQ(read_file(derived / "metrics.jsonl"), read_file(run_dir / "metrics.jsonl"));
+  const auto biased = nlohmann::json::parse(read_file(derived / "eval_test.json"));
+  EXPECT_EQ(biased["epoch"], report["epoch"]);
+  EXPECT_NE(biased["mean"]["avg_l1"].get<double>(), m["avg_l1"].get<double>());
+  const Result unchanged = run("eval " + run_dir.string() + " --run-id ci2");
+  EXPECT_NE(unchanged.status, 0);
+  EXPECT_NE(unchanged.err.find("none were given"), std::string::npos) << unchanged.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "results" / "smoke" / "ci2"));
+
   // Error maps of the evaluated run: a PNG per map and a PLY per map, and per-vertex L1 values
   // whose mean is the evaluation's avg_l1 of that character (the README quotes it).
   const std::filesystem::path figures = dir / "figures";

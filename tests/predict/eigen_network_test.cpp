@@ -6,8 +6,10 @@
 
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <iostream>
 #include <set>
 
@@ -96,17 +98,18 @@ losses: [{type: kl}]
 data: {file: unused.h5, split: random, distance: euclidean}
 )";
 
-/// The random network of kConfig built for `model_k` candidates, and the player prepared with
-/// `prepared_k` (fewer when the player has fewer bones): libtorch's weights and the Eigen
-/// network's through the parameter file.
+/// The random network of kConfig built for `model_k` candidates (with `leaf_bias`), and the
+/// player prepared with `prepared_k` (fewer when the player has fewer bones): libtorch's weights
+/// and the Eigen network's through the parameter file.
 struct BothPaths {
   data::PreparedCharacter prepared;
   data::RowMatrixXf libtorch, eigen;
 };
 
-BothPaths both_paths(int model_k, int prepared_k) {
+BothPaths both_paths(int model_k, int prepared_k, double leaf_bias = 0) {
   std::string yaml = kConfig;
-  yaml.replace(yaml.find("top_k: 3"), 8, "top_k: " + std::to_string(model_k));
+  yaml.replace(yaml.find("top_k: 3"), 8,
+               fmt::format("top_k: {}\n  leaf_bias: {}", model_k, leaf_bias));
   const train::RunOptions options = train::RunOptions::from(config::Config::parse(yaml));
   const auto model = train::build_model(options);
   model->eval();
@@ -158,6 +161,31 @@ TEST(EigenNetwork, ACharacterWithFewerBonesThanKGetsWeightsOnItsOwnBones) {
 
   // Fewer candidates than K on a character that has more bones is a mismatch, not padded.
   EXPECT_THROW(both_paths(3, 2), c10::Error);
+}
+
+TEST(EigenNetwork, LeafBiasMultipliesTheLeafCandidatesWeightsInBothPaths) {
+  // The same random parameters (kConfig's seed) with and without a leaf bias of 0.7: each leaf
+  // candidate's weight is multiplied by e^0.7 and the row renormalised, in both paths alike.
+  const double bias = 0.7;
+  const BothPaths plain = both_paths(3, 3);
+  const BothPaths biased = both_paths(3, 3, bias);
+  const auto& d = plain.prepared.distances.at("euclidean");
+  const auto& bones = plain.prepared.bones;
+  data::RowMatrixXf expected = plain.libtorch;
+  int leaf_candidates = 0;
+  for (Eigen::Index v = 0; v < expected.rows(); ++v) {
+    for (Eigen::Index j = 0; j < expected.cols(); ++j) {
+      const int b = d.topk_index(v, j);
+      if (bones(b, 0) != bones(b, 1)) continue;
+      expected(v, j) *= static_cast<float>(std::exp(bias));
+      ++leaf_candidates;
+    }
+    expected.row(v) /= expected.row(v).sum();
+  }
+  ASSERT_GT(leaf_candidates, 100) << "the player's hands, feet and head are leaves";
+  EXPECT_LE(max_difference(biased.libtorch, expected), 1e-5);
+  EXPECT_LE(max_difference(biased.eigen, biased.libtorch), 1e-5);
+  EXPECT_GT(max_difference(biased.libtorch, plain.libtorch), 1e-3);
 }
 
 TEST(EigenNetwork, ParameterFileRoundTripsAndIsWrittenWhole) {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "framework/data/preprocess.hpp"
+#include "framework/tensors/candidates.hpp"
 #include "framework/tensors/tensors.hpp"
 #include "tests/data/data_fixtures.hpp"
 #include "tests/test_util.hpp"
@@ -122,6 +123,30 @@ TEST(ScatterToBones, RejectsBadArguments) {
                            {"pred is [2, 2] but topk_index is [2, 1]"});
   expect_error<c10::Error>([&] { data::scatter_to_bones(pred, index, 1); },
                            {"2 candidates per vertex but only 1 bones"});
+}
+
+TEST(CandidatesForModel, PadsASmallSkeletonsCandidatesWithTheNearestAndRefusesOtherCounts) {
+  const data::CharacterTensors three = data::to_tensors(testing::prepared_tube(1), "euclidean");
+  // As many candidates as the model reads: the same tensors.
+  const data::CharacterTensors same = data::candidates_for_model(three, 3, "m");
+  EXPECT_TRUE(same.topk_index.is_same(three.topk_index));
+
+  // One candidate per bone (6), read by a K = 8 model: columns 6 and 7 repeat column 0.
+  const data::CharacterTensors six = data::to_tensors(testing::prepared_tube(1, 8), "euclidean");
+  ASSERT_EQ(six.top_k(), six.num_bones());
+  const data::CharacterTensors padded = data::candidates_for_model(six, 8, "m");
+  ASSERT_EQ(padded.top_k(), 8);
+  EXPECT_TRUE(torch::equal(padded.topk_index.narrow(1, 0, 6), six.topk_index));
+  EXPECT_TRUE(torch::equal(padded.topk_distance.narrow(1, 0, 6), six.topk_distance));
+  for (std::int64_t j = 6; j < 8; ++j) {
+    EXPECT_TRUE(torch::equal(padded.topk_index.select(1, j), six.topk_index.select(1, 0)));
+    EXPECT_TRUE(torch::equal(padded.topk_distance.select(1, j), six.topk_distance.select(1, 0)));
+  }
+  EXPECT_EQ(padded.targets.size(1), 6);  // the loss compares the model's #V×6 with these
+
+  // Fewer candidates than K on a character with more bones than that: a mismatch.
+  expect_error<c10::Error>([&] { data::candidates_for_model(three, 4, "the model"); },
+                           {"the model", "top_k = 4", "'tube_1'", "3 candidate", "6 bones"});
 }
 
 }  // namespace SKINLAB_UNITY_ID

@@ -101,14 +101,14 @@ inline datasets::SourceCharacter tube_character(int index) {
   return s;
 }
 
-/// Preprocessed as `skinlab prepare` does, with the euclidean distance and K = 3; the ~80-vertex
-/// tubes are subdivided once (min_vertices 100).
-inline data::PreparedCharacter prepared_tube(int index) {
+/// Preprocessed as `skinlab prepare` does, with the euclidean distance and K = `top_k` (capped at
+/// the tube's 6 bones); the ~80-vertex tubes are subdivided once (min_vertices 100).
+inline data::PreparedCharacter prepared_tube(int index, int top_k = 3) {
   const auto euclidean = distance_registry().create(config::Config::parse("type: euclidean").root());
   data::PreprocessOptions options;
   options.min_vertices = 100;
   options.max_vertices = 2000;
-  options.top_k = 3;
+  options.top_k = top_k;
   return data::preprocess(tube_character(index), {{"euclidean", euclidean}}, options);
 }
 
