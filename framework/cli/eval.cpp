@@ -11,10 +11,11 @@
 /// as a run of its own, `<results_dir>/<experiment>/<ID>` (experiment after the overrides, e.g.
 /// `experiment=..._leaf_bias model.leaf_bias=0.5`): the config with the overrides applied,
 /// env.json, a copy of the source's metrics.jsonl and its checkpoint (`--checkpoint`, a hard link
-/// where the file system allows, else a copy), so `skinlab table` compares it with its source like any two runs. For
-/// settings that act after training only (models::BranchedModelOptions::leaf_bias,
-/// keep_prior_outside, the metrics' pruning); the checkpoint must still load under the
-/// overrides.
+/// where the file system allows, else a copy), so `skinlab table` compares it with its source
+/// like any two runs. For settings that act after training only
+/// (models::BranchedModelOptions::leaf_bias, keep_prior_outside, the metrics' pruning, another
+/// dataset file); an override under which the checkpoint does not load is an error before the
+/// directory is made.
 ///
 /// `--nproc N` shards the characters of a skinning run over N worker processes on this machine
 /// (core/launch.hpp); rank 0 gathers the values and predictions and writes the files. A process
@@ -92,6 +93,9 @@ RunDir derive_run(EvalArgs& args) {
   const config::Config config =
       config::Config::load(source.file("config.yaml"), args.options.overrides);
   const train::RunOptions o = train::RunOptions::from(config);
+  // The checkpoint must load into the model the overrides describe: an error before any
+  // directory is made (e.g. an override that changes a width).
+  train::load_checkpoint(checkpoint, *train::build_model(o));
   RunDir run = train::create_run(config, o, args.run_id, command_line());
   std::cout << "run: " << run.path().string() << " (the checkpoint of " << args.run << ")\n";
   const fs::path linked = run.file(checkpoint.filename().string());

@@ -359,6 +359,10 @@ TEST(Cli, SmokeRunPrepareTrainEvalOnTheBundledSubset) {
   EXPECT_NE(unchanged.status, 0);
   EXPECT_NE(unchanged.err.find("none were given"), std::string::npos) << unchanged.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "results" / "smoke" / "ci2"));
+  const Result wider = run("eval " + run_dir.string() + " model.head=[7] --run-id ci3");
+  EXPECT_NE(wider.status, 0);
+  EXPECT_NE(wider.err.find("best.pt"), std::string::npos) << wider.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "results" / "smoke" / "ci3"));
 
   // Error maps of the evaluated run: a PNG per map and a PLY per map, and per-vertex L1 values
   // whose mean is the evaluation's avg_l1 of that character (the README quotes it).
