@@ -45,9 +45,7 @@ torch::Tensor RigNetSkin::input_features(const data::CharacterTensors& c) const 
   parts.push_back(models::inverse_distance(c.topk_distance, options_).reshape({nv, k, 1}));
   if (options_.leaf_flag) {
     // RigNet's virtual leaf bone is our helper bone at a leaf joint: start joint == end joint.
-    const torch::Tensor leaf =
-        (c.bone_joints.select(1, 0) == c.bone_joints.select(1, 1)).to(c.positions.scalar_type());
-    parts.push_back(leaf.index_select(0, flat).reshape({nv, k, 1}));
+    parts.push_back(models::leaf_candidates(c).reshape({nv, k, 1}));
   }
   return torch::cat({c.positions, torch::cat(parts, 2).reshape({nv, -1})}, 1);
 }

@@ -14,7 +14,6 @@
 
 #include "framework/core/config.hpp"
 #include "framework/core/registry.hpp"
-#include "framework/tensors/candidates.hpp"
 #include "framework/tensors/tensors.hpp"
 #include "tests/train/train_fixtures.hpp"
 
