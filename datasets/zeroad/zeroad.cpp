@@ -190,6 +190,7 @@ std::vector<SourceCharacter> ZeroAdBuilder::read(std::vector<Excluded>& excluded
     sc.licence = "CC-BY-SA-3.0";
     sc.attribution = "Wildfire Games (0 A.D.)";
     sc.skeleton = std_skel.id;
+    sc.left_handed = true;  // the game's frame (read_pmd.hpp)
     geometry::Character& ch = sc.character;
     ch.name = name;
     ch.mesh.V = pmd.positions;

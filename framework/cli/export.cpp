@@ -1,11 +1,18 @@
 /// \file
 /// `skinlab export <dataset.yaml> <character>... (--out FILE | --out-dir DIR)`: characters of a
 /// dataset's raw sources (the builders of its `sources:`, e.g. 0 A.D.'s PMD files) as their
-/// artist made them, in their own frame and vertex order, with their artist weights, as
+/// artist made them, in their own vertex order and units, with their artist weights, as
 ///
 ///     .glb / .gltf   glTF 2.0 skin (geometry/gltf_export.hpp; at most 4 weights per vertex,
 ///                    as game engines keep them), rotated to glTF's +Y up if the source is not
 ///     .obj           OBJ mesh plus `<stem>_rig.txt` beside it (RigNet rig text, every weight)
+///
+/// Both formats are right-handed with faces wound counter-clockwise seen from outside (the glTF
+/// 2.0 specification's front faces; OBJ by convention), so a left-handed source
+/// (SourceCharacter::left_handed: 0 A.D.) is mirrored front to back (z → −z): its `_L` joints
+/// come out on its left, it faces +Z as glTF assets do, and its faces point outwards. Written in the game's frame instead, every
+/// 0 A.D. character was inside out for the programs that read front from back (Blender's bone
+/// heat: its visibility test and normal-weighted distance) and a mirror image for the rest.
 ///
 /// So a game character of the dataset's test split can be fed to `skinlab predict`, Blender or
 /// any other tool like a user's own file. Names are the dataset's (`skinlab dataset-card`).
@@ -45,6 +52,11 @@ void check_extension(const std::string& where, const std::string& ext) {
 /// Writes one character as `out` (its extension picks the format) and says so.
 void write_character(datasets::SourceCharacter& source, const fs::path& out) {
   geometry::Character& c = source.character;
+  if (source.left_handed) {
+    c.mesh.V.col(2) *= -1.0;
+    c.skeleton.positions.col(2) *= -1.0;
+    if (c.skeleton.leaf_tips.rows() > 0) c.skeleton.leaf_tips.col(2) *= -1.0;
+  }
   if (out.extension() == ".obj") {
     fs::path rig = out;
     rig.replace_filename(out.stem().string() + "_rig.txt");

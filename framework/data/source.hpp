@@ -37,6 +37,12 @@ struct SourceCharacter {
   /// The up direction of the character's frame; preprocessing rotates it to +Y (normalize.hpp),
   /// e.g. +Z for the Quake-lineage formats IQM and ZYM.
   Eigen::Vector3d up = Eigen::Vector3d::UnitY();
+  /// The frame is left-handed (0 A.D.'s game frame, read_pmd.hpp): read as right-handed x, y, z
+  /// the character is its own mirror image (0 A.D.'s `_L` joints sit on its right) with every
+  /// face wound clockwise seen from outside. Preparation keeps the frame (the methods that read
+  /// inside and outside orient the faces first, geometry/orient_outward.hpp); `skinlab export`
+  /// mirrors front to back so that another program gets the character as the game shows it.
+  bool left_handed = false;
   /// bind[j]: joint j's bind-pose global transform (the frame of `character`), as Animation::bind
   /// but kept whether or not the character has a clip, so that another clip of its skeleton
   /// family can pose it (DenseGATs' corrective task). Empty when the source gives joint positions

@@ -22,6 +22,7 @@
 #include "framework/geometry/rig_io.hpp"
 #include "framework/infer/parameters.hpp"
 #include "tests/cli/cli_run.hpp"
+#include "tests/geometry/test_meshes.hpp"
 #include "tests/test_util.hpp"
 
 namespace skinlab {
@@ -340,6 +341,26 @@ TEST(PredictCli, GameCharacterExportedFromItsSourceIsSkinnedAndRendered) {
   geometry::ImportOptions o;
   o.join_identical_vertices = false;
   const geometry::Character artist = geometry::import_character(horse, o);
+  // 0 A.D.'s frame is left-handed: the export mirrors it, so the horse faces +Z as glTF assets
+  // do, its left legs are on its left (+X when facing +Z) and its faces point outwards.
+  const auto joint = [&](const geometry::Character& c, const std::string& name) {
+    const int j = c.skeleton.find(name);
+    EXPECT_GE(j, 0) << name;
+    return Eigen::Vector3d(c.skeleton.positions.row(std::max(j, 0)));
+  };
+  EXPECT_GT(joint(artist, "head").z(), joint(artist, "tail").z());
+  EXPECT_GT(joint(artist, "l_hoof").x(), 0);
+  EXPECT_LT(joint(artist, "r_hoof").x(), 0);
+  EXPECT_GT(testing::signed_volume(artist.mesh.V, artist.mesh.F), 0);
+  // The OBJ + rig export is the same character, mirrored the same way.
+  const Result obj = run("export configs/datasets/zeroad_bundled.yaml horse --out " +
+                         (dir / "horse.obj").string());
+  ASSERT_EQ(obj.status, 0) << obj.err;
+  const geometry::Character rigged =
+      geometry::read_obj_rig(dir / "horse.obj", dir / "horse_rig.txt");
+  EXPECT_GT(joint(rigged, "l_hoof").x(), 0);
+  EXPECT_GT(joint(rigged, "head").z(), joint(rigged, "tail").z());
+  EXPECT_GT(testing::signed_volume(rigged.mesh.V, rigged.mesh.F), 0);
 
   const fs::path out = dir / "horse_skinned.glb", png = dir / "horse.png";
   const Result r = run("predict " + horse.string() + " --compare-to-input --out " + out.string() +

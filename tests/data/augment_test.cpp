@@ -14,6 +14,7 @@
 #include "framework/data/preprocess.hpp"
 #include "tests/bundled_dataset.hpp"
 #include "tests/data/data_fixtures.hpp"
+#include "tests/geometry/test_meshes.hpp"
 #include "tests/test_util.hpp"
 
 namespace skinlab {
@@ -63,14 +64,7 @@ Eigen::Vector3d face_normal(const data::PreparedCharacter& c, Eigen::Index f) {
 }
 
 /// Σ a·(b × d) / 6 over the faces: the enclosed volume, positive when the faces face outwards.
-double signed_volume(const data::PreparedCharacter& c) {
-  double v = 0;
-  for (Eigen::Index f = 0; f < c.F.rows(); ++f) {
-    const Eigen::Vector3d a = c.V.row(c.F(f, 0)), b = c.V.row(c.F(f, 1)), d = c.V.row(c.F(f, 2));
-    v += a.dot(b.cross(d)) / 6;
-  }
-  return v;
-}
+double signed_volume(const data::PreparedCharacter& c) { return testing::signed_volume(c.V, c.F); }
 
 Eigen::RowVector3d extent(const Eigen::MatrixXd& V) {
   return V.colwise().maxCoeff() - V.colwise().minCoeff();

@@ -6,6 +6,8 @@
 
 #include <Eigen/Geometry>
 
+#include "tests/geometry/test_meshes.hpp"
+
 namespace skinlab::geometry {
 namespace {
 namespace SKINLAB_UNITY_ID {  // unique per file in a unity build
@@ -32,12 +34,7 @@ void add_tetrahedron(Eigen::MatrixXd& V, Eigen::MatrixXi& F, const Eigen::Vector
 }
 
 double signed_volume(const Mesh& m, int first_face, int faces) {
-  double v = 0;
-  for (int f = first_face; f < first_face + faces; ++f) {
-    const Eigen::Vector3d a = m.V.row(m.F(f, 0)), b = m.V.row(m.F(f, 1)), c = m.V.row(m.F(f, 2));
-    v += a.dot(b.cross(c)) / 6;
-  }
-  return v;
+  return testing::signed_volume(m.V, m.F, first_face, faces);
 }
 
 TEST(OrientOutward, FlipsOnlyThePartsWoundInwards) {

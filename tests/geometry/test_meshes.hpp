@@ -11,6 +11,19 @@
 
 namespace skinlab::testing {
 
+/// Σ a·(b × c) / 6 over faces [first, first + count) of (V, F) (count < 0: to the last): the
+/// volume they enclose, positive when they are wound counter-clockwise seen from outside.
+inline double signed_volume(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                            Eigen::Index first = 0, Eigen::Index count = -1) {
+  const Eigen::Index end = count < 0 ? F.rows() : first + count;
+  double v = 0;
+  for (Eigen::Index f = first; f < end; ++f) {
+    const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+    v += a.dot(b.cross(c)) / 6;
+  }
+  return v;
+}
+
 /// Regular tetrahedron-like closed mesh: 4 vertices, 6 edges, 4 outward faces.
 inline geometry::Mesh tetrahedron() {
   geometry::Mesh m;
