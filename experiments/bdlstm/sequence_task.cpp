@@ -17,6 +17,7 @@
 #include "framework/core/timing.hpp"
 #include "framework/geometry/gltf_export.hpp"
 #include "framework/geometry/obj_io.hpp"
+#include "framework/geometry/orient_outward.hpp"
 #include "framework/train/checkpoint.hpp"
 #include "framework/train/fit_support.hpp"
 
@@ -654,13 +655,16 @@ GeneratedSequence generate_sequence(const RunDir& run, const GenerateOptions& op
   }
 
   const double fps = options.fps > 0 ? options.fps : (q.fps > 0 ? q.fps : 30.0);
+  // The faces wound outwards (per part, on the bind-pose mesh), as glTF and OBJ viewers expect:
+  // the dataset keeps each source's winding, and 0 A.D.'s left-handed frame winds them inwards.
+  const Eigen::MatrixXi faces = geometry::orient_outward(ch.rest).F;
   write_directory_atomic(out, [&](const fs::path& staging) {
     const auto write_frames = [&](const std::string& stem, const std::vector<Eigen::MatrixXd>& list) {
       for (std::size_t t = 0; t < list.size(); ++t) {
-        geometry::write_obj(staging / fmt::format("{}_{:04d}.obj", stem, t), geometry::Mesh{list[t], ch.rest.F});
+        geometry::write_obj(staging / fmt::format("{}_{:04d}.obj", stem, t), geometry::Mesh{list[t], faces});
       }
       geometry::write_gltf_morph_animation(staging / (stem == "frame" ? "sequence.glb" : "truth.glb"),
-                                           ch.name + "/" + q.clip, ch.rest.F, list, fps);
+                                           ch.name + "/" + q.clip, faces, list, fps);
     };
     write_frames("frame", frames);
     write_frames("truth", truth);

@@ -14,6 +14,7 @@
 #include "framework/data/h5.hpp"
 #include "framework/geometry/obj_io.hpp"
 #include "tests/cli/cli_run.hpp"
+#include "tests/geometry/test_meshes.hpp"
 #include "tests/test_util.hpp"
 
 namespace skinlab {
@@ -674,6 +675,9 @@ TEST(Cli, BdlstmSmokeSweepOnTheBundledWolf) {
     EXPECT_EQ(frame.F, first.F);
   }
   EXPECT_FALSE(std::filesystem::exists(seq / "frame_0007.obj"));
+  // Faces wound outwards, as viewers expect (the prepared wolf keeps 0 A.D.'s inward winding).
+  const geometry::Mesh first = geometry::read_obj(seq / "frame_0000.obj");
+  EXPECT_GT(testing::signed_volume(first.V, first.F), 0);
   // The initial frames are the clip's own frames.
   EXPECT_EQ(geometry::read_obj(seq / "frame_0002.obj").V, geometry::read_obj(seq / "truth_0002.obj").V);
   EXPECT_GT(info["frames"][0]["error_mm"].get<double>(), 0);
