@@ -10,9 +10,10 @@
 /// Both formats are right-handed with faces wound counter-clockwise seen from outside (the glTF
 /// 2.0 specification's front faces; OBJ by convention), so a left-handed source
 /// (SourceCharacter::left_handed: 0 A.D.) is mirrored front to back (z → −z): its `_L` joints
-/// come out on its left, it faces +Z as glTF assets do, and its faces point outwards. Written in the game's frame instead, every
-/// 0 A.D. character was inside out for the programs that read front from back (Blender's bone
-/// heat: its visibility test and normal-weighted distance) and a mirror image for the rest.
+/// come out on its left, it faces +Z as glTF assets do, and its faces point outwards. Written in
+/// the game's frame instead, every 0 A.D. character was inside out for the programs that read
+/// front from back (Blender's bone heat: its visibility test and normal-weighted distance) and a
+/// mirror image for the rest.
 ///
 /// So a game character of the dataset's test split can be fed to `skinlab predict`, Blender or
 /// any other tool like a user's own file. Names are the dataset's (`skinlab dataset-card`).
