@@ -9,11 +9,11 @@
 ///
 /// Both formats are right-handed with faces wound counter-clockwise seen from outside (the glTF
 /// 2.0 specification's front faces; OBJ by convention), so a left-handed source
-/// (SourceCharacter::left_handed: 0 A.D.) is mirrored front to back (z → −z): its `_L` joints
-/// come out on its left, it faces +Z as glTF assets do, and its faces point outwards. Written in
-/// the game's frame instead, every 0 A.D. character was inside out for the programs that read
-/// front from back (Blender's bone heat: its visibility test and normal-weighted distance) and a
-/// mirror image for the rest.
+/// (SourceCharacter::left_handed: 0 A.D. in its game frame) is mirrored front to back
+/// (data/source.hpp make_right_handed: z → −z): its `_L` joints come out on its left, it faces +Z
+/// as glTF assets do, and its faces point outwards. Written in the game's frame instead, every
+/// 0 A.D. character was inside out for the programs that read front from back (Blender's bone
+/// heat: its visibility test and normal-weighted distance) and a mirror image for the rest.
 ///
 /// So a game character of the dataset's test split can be fed to `skinlab predict`, Blender or
 /// any other tool like a user's own file. Names are the dataset's (`skinlab dataset-card`).
@@ -34,6 +34,7 @@
 #include "framework/core/error.hpp"
 #include "framework/core/registry.hpp"
 #include "framework/data/prepare.hpp"
+#include "framework/data/source.hpp"
 #include "framework/geometry/gltf_export.hpp"
 #include "framework/geometry/obj_io.hpp"
 #include "framework/geometry/rig_io.hpp"
@@ -52,12 +53,8 @@ void check_extension(const std::string& where, const std::string& ext) {
 
 /// Writes one character as `out` (its extension picks the format) and says so.
 void write_character(datasets::SourceCharacter& source, const fs::path& out) {
+  datasets::make_right_handed(source);
   geometry::Character& c = source.character;
-  if (source.left_handed) {
-    c.mesh.V.col(2) *= -1.0;
-    c.skeleton.positions.col(2) *= -1.0;
-    if (c.skeleton.leaf_tips.rows() > 0) c.skeleton.leaf_tips.col(2) *= -1.0;
-  }
   if (out.extension() == ".obj") {
     fs::path rig = out;
     rig.replace_filename(out.stem().string() + "_rig.txt");

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <set>
 
 #include "framework/binders/binder.hpp"
@@ -33,6 +34,7 @@ PreprocessOptions PreprocessOptions::from(const config::Node& node) {
   o.leaf_bones = distances::LeafBoneOptions::from(f.section("leaf_bones"));
   f.optional("drop_weightless_leaves", o.drop_weightless_leaves);
   f.optional("drop_seed", o.drop_seed);
+  f.optional("right_handed", o.right_handed);
   o.augment = AugmentOptions::from(f.section("augment"));
   const config::Node priors = f.section("priors");
   if (priors.exists()) {
@@ -169,10 +171,17 @@ AnimationData convert(const datasets::Animation& a, const Eigen::Matrix4d& sim, 
 
 }  // namespace
 
-PreparedCharacter preprocess(const datasets::SourceCharacter& source,
+PreparedCharacter preprocess(const datasets::SourceCharacter& as_read,
                              const std::vector<NamedDistance>& distances,
                              const PreprocessOptions& options, const PreprocessMode& mode,
                              PreprocessTimes* times) {
+  // 0. The frame: a copy only where the character is mirrored (its clips can be large).
+  std::optional<datasets::SourceCharacter> mirrored;
+  if (options.right_handed && as_read.left_handed) {
+    mirrored = as_read;
+    datasets::make_right_handed(*mirrored);
+  }
+  const datasets::SourceCharacter& source = mirrored ? *mirrored : as_read;
   using Clock = std::chrono::steady_clock;
   auto lap = [last = Clock::now()](double* into) mutable {
     const auto now = Clock::now();

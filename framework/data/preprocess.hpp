@@ -3,7 +3,9 @@
 /// Preprocessing of one character as HeterSkinNet (Pan et al. 2021) Sec. 4.1, plus everything a
 /// network needs per character (Sec. 3.2–3.4), computed once and stored in the dataset file:
 ///
-/// 0. with probability `drop_weightless_leaves`, remove the character's weightless end joints
+/// 0. with `right_handed`, read a left-handed character (0 A.D.'s game frame) as the right-handed
+///    one it shows (source.hpp make_right_handed: mirrored front to back, clips included); with
+///    probability `drop_weightless_leaves`, remove the character's weightless end joints
 ///    (geometry/weightless_leaves.hpp);
 /// 1. normalise: Y up, 1 m tall, feet at y = 0, x/z centred (geometry/normalize.hpp); the
 ///    similarity is kept (PreparedCharacter::normalisation);
@@ -64,6 +66,11 @@ struct PreprocessOptions {
   /// predict for) are never changed. 0: off (the paper).
   double drop_weightless_leaves = 0.0;
   std::int64_t drop_seed = 0;
+  /// Step 0: mirror left-handed characters (SourceCharacter::left_handed) front to back into
+  /// the right-handed frame every glTF, OBJ or FBX a user has is in. false (the default) keeps
+  /// the source's frame, as every dataset prepared before the option existed; right-handed
+  /// characters are never changed.
+  bool right_handed = false;
   /// Augmented training copies (augment.hpp; `copies: 0`, the default, is off). Made by
   /// `skinlab prepare` for the characters some split trains on (prepare.hpp).
   AugmentOptions augment;

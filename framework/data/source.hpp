@@ -41,7 +41,8 @@ struct SourceCharacter {
   /// the character is its own mirror image (0 A.D.'s `_L` joints sit on its right) with every
   /// face wound clockwise seen from outside. Preparation keeps the frame (the methods that read
   /// inside and outside orient the faces first, geometry/orient_outward.hpp); `skinlab export`
-  /// mirrors front to back so that another program gets the character as the game shows it.
+  /// mirrors front to back so that another program gets the character as the game shows it, and
+  /// so does preparation with `preprocess.right_handed: true` (make_right_handed below).
   bool left_handed = false;
   /// bind[j]: joint j's bind-pose global transform (the frame of `character`), as Animation::bind
   /// but kept whether or not the character has a clip, so that another clip of its skeleton
@@ -51,6 +52,17 @@ struct SourceCharacter {
   std::vector<Eigen::Isometry3d> bind;
   std::vector<Animation> animations;
 };
+
+/// Reads a left-handed character (SourceCharacter::left_handed) as the right-handed one it shows:
+/// mirrors it front to back (z → −z) in everything that has a position or orientation: the mesh,
+/// the joint positions and leaf tips, the bind transforms and every clip's frames and bind
+/// (B ↦ M·B·M with M = diag(1, 1, −1), so LBS of the mirrored mesh with the mirrored transforms
+/// is the mirror image of LBS before). Mirroring reverses the winding, so faces wound clockwise
+/// seen from outside come out counter-clockwise, the glTF and OBJ convention; the weights and the
+/// joint order do not change. Clears `left_handed`; a right-handed character is left as it is.
+/// Used by `skinlab export` and by preprocessing asked for the right-handed frame
+/// (`preprocess.right_handed`, data/preprocess.hpp).
+void make_right_handed(SourceCharacter& source);
 
 /// A character a builder could not use, with the reason (reported in the dataset card).
 struct Excluded {

@@ -234,6 +234,33 @@ TEST(PreprocessLeaves, DroppedWeightlessEndJointsTakeTheirClipTransformsWithThem
   EXPECT_EQ(data::preprocess(plain, euclidean()).leaf_tips.size(), 0);  // the paper's default
 }
 
+// `right_handed` mirrors a left-handed character (0 A.D.'s game frame) front to back before
+// everything else, so the prepared mesh and joints are the mirror image of the left-handed
+// preparation (normalisation centres z, so the mirror is about z = 0), with the same distances
+// (a mirror keeps them); a right-handed character is prepared as without the option.
+TEST(PreprocessFrame, RightHandedMirrorsOnlyLeftHandedCharacters) {
+  datasets::SourceCharacter left = testing::minetest_player();
+  left.left_handed = true;
+  data::PreprocessOptions mirror;
+  mirror.right_handed = true;
+  const data::PreparedCharacter kept = data::preprocess(left, euclidean());
+  const data::PreparedCharacter mirrored = data::preprocess(left, euclidean(), mirror);
+  const Eigen::Vector3d flip(1, 1, -1);
+  ASSERT_EQ(mirrored.V.rows(), kept.V.rows());
+  EXPECT_LT((mirrored.V - kept.V * flip.asDiagonal()).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_LT((mirrored.joints - kept.joints * flip.asDiagonal()).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_EQ(mirrored.F, kept.F);
+  ASSERT_EQ(mirrored.distances.size(), kept.distances.size());
+  for (const auto& [type, d] : kept.distances) {
+    EXPECT_EQ(mirrored.distances.at(type).topk_index, d.topk_index) << type;
+  }
+  const datasets::SourceCharacter right = testing::minetest_player();
+  EXPECT_EQ(data::preprocess(right, euclidean(), mirror).V, data::preprocess(right, euclidean()).V);
+  EXPECT_TRUE(data::PreprocessOptions::from(
+                  config::Config::parse("preprocess: {right_handed: true}").root()["preprocess"])
+                  .right_handed);
+}
+
 TEST(PreprocessOptions, UnknownFieldIsAnError) {
   const auto config = config::Config::parse("preprocess: {top_kk: 3}");
   testing::expect_error<ConfigError>(

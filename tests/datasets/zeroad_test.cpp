@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include "../geometry/test_meshes.hpp"
 #include "../test_util.hpp"
 #include "datasets/zeroad/package.hpp"
 #include "datasets/zeroad/read_actor.hpp"
@@ -381,6 +382,58 @@ TEST(ZeroAdLbs, ClipFramesMoveMeshesPlausibly) {
       EXPECT_GT(largest, 0.01 * diag) << name << " " << a.name << ": the clip should move the mesh";
     }
   }
+}
+
+// make_right_handed (data/source.hpp) reads the game's left-handed frame as the right-handed
+// mirror image another program shows: the horse faces +Z with its left hooves at +X and outward
+// faces, and every position, bind transform and clip frame is the game frame's mirrored front to
+// back, so that a clip poses the mirrored mesh into the mirror image of the pose.
+TEST(ZeroAdFrame, RightHandedIsTheMirrorImageOfTheGameFrame) {
+  const Eigen::Vector3d flip(1, 1, -1);
+  for (const SourceCharacter& game : built().characters) {
+    SourceCharacter rh = game;
+    make_right_handed(rh);
+    const std::string& name = rh.character.name;
+    EXPECT_TRUE(game.left_handed) << name;
+    EXPECT_FALSE(rh.left_handed) << name;
+    EXPECT_EQ(rh.character.mesh.V, Eigen::MatrixXd(game.character.mesh.V * flip.asDiagonal())) << name;
+    EXPECT_EQ(rh.character.mesh.F, game.character.mesh.F) << name;
+    EXPECT_EQ(rh.character.skeleton.positions,
+              Eigen::MatrixXd(game.character.skeleton.positions * flip.asDiagonal())) << name;
+    ASSERT_EQ(rh.bind.size(), game.bind.size()) << name;
+    for (std::size_t j = 0; j < rh.bind.size(); ++j) {
+      EXPECT_EQ(Eigen::Vector3d(rh.bind[j].translation()),
+                Eigen::Vector3d(flip.cwiseProduct(game.bind[j].translation())))
+          << name << " " << j;
+      EXPECT_NEAR(rh.bind[j].linear().determinant(), 1.0, 1e-9) << name << " " << j;
+    }
+    ASSERT_EQ(rh.animations.size(), game.animations.size()) << name;
+    for (std::size_t a = 0; a < rh.animations.size(); ++a) {
+      ASSERT_EQ(rh.animations[a].frames.size(), game.animations[a].frames.size());
+      for (std::size_t f = 0; f < rh.animations[a].frames.size(); f += 7) {
+        const Eigen::MatrixXd posed = pose(rh, rh.animations[a], f);
+        const Eigen::MatrixXd expected = pose(game, game.animations[a], f) * flip.asDiagonal();
+        EXPECT_LT((posed - expected).cwiseAbs().maxCoeff(), 1e-9 * diagonal(expected))
+            << name << " " << rh.animations[a].name << " frame " << f;
+      }
+    }
+    // A right-handed character is left as it is.
+    SourceCharacter again = rh;
+    make_right_handed(again);
+    EXPECT_EQ(again.character.mesh.V, rh.character.mesh.V) << name;
+  }
+  SourceCharacter horse = built().get("horse");
+  EXPECT_LT(testing::signed_volume(horse.character.mesh.V, horse.character.mesh.F), 0);
+  make_right_handed(horse);
+  const auto joint = [&](const std::string& n) {
+    const int j = horse.character.skeleton.find(n);
+    EXPECT_GE(j, 0) << n;
+    return Eigen::Vector3d(horse.character.skeleton.positions.row(std::max(j, 0)));
+  };
+  EXPECT_GT(joint("head").z(), joint("tail").z());
+  EXPECT_GT(joint("l_hoof").x(), 0);
+  EXPECT_LT(joint("r_hoof").x(), 0);
+  EXPECT_GT(testing::signed_volume(horse.character.mesh.V, horse.character.mesh.F), 0);
 }
 
 TEST(ZeroAdBuilder, OptionsFromConfig) {
