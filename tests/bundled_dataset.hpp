@@ -39,20 +39,31 @@ inline data::Dataset prepare_bundled(const std::string& config, const std::strin
   return data::read_dataset(output);
 }
 
-/// The characters of the bundled 0 A.D. subset, as its builder reads them from the game files,
-/// that the evaluation of the model in `model_dir` (its eval_test.json) scored.
+/// The characters of the bundled 0 A.D. subset that the evaluation of the model in `model_dir`
+/// (its eval_test.json) scored, as its builder reads them from the game files and in the frame
+/// the model's dataset was prepared in: mirrored into the right-handed frame
+/// (datasets::make_right_handed) when the model's preparation.yaml sets
+/// `preprocess.right_handed`, as `prepare` did for its evaluation and `skinlab export` does for a
+/// user's file.
 inline std::vector<datasets::SourceCharacter> bundled_test_characters(
     const std::filesystem::path& model_dir) {
   const nlohmann::json eval = nlohmann::json::parse(read_file(model_dir / "eval_test.json"));
   std::set<std::string> test;
   for (const auto& c : eval.at("per_character")) test.insert(c.at("character").get<std::string>());
+  const config::Node preprocess =
+      config::Config::load((model_dir / "preparation.yaml").string()).root()["preprocess"];
+  const bool right_handed =
+      preprocess.has("right_handed") && preprocess["right_handed"].as<bool>();
   const data::PrepareConfig config =
       bundled_config("configs/datasets/zeroad_bundled.yaml", "unused.h5");
   std::vector<datasets::Excluded> excluded;
   std::vector<datasets::SourceCharacter> characters;
   for (const auto& node : config.sources)
     for (auto& source : dataset_registry().create(node)->read(excluded))
-      if (test.count(source.character.name)) characters.push_back(std::move(source));
+      if (test.count(source.character.name)) {
+        if (right_handed) datasets::make_right_handed(source);
+        characters.push_back(std::move(source));
+      }
   return characters;
 }
 
