@@ -14,6 +14,7 @@
 #include "framework/core/registry.hpp"
 #include "framework/data/dataset_file.hpp"
 #include "framework/data/prepare.hpp"
+#include "framework/data/preprocess.hpp"
 #include "framework/data/source.hpp"
 
 namespace skinlab::testing {
@@ -50,10 +51,10 @@ inline std::vector<datasets::SourceCharacter> bundled_test_characters(
   const nlohmann::json eval = nlohmann::json::parse(read_file(model_dir / "eval_test.json"));
   std::set<std::string> test;
   for (const auto& c : eval.at("per_character")) test.insert(c.at("character").get<std::string>());
-  const config::Node preprocess =
-      config::Config::load((model_dir / "preparation.yaml").string()).root()["preprocess"];
   const bool right_handed =
-      preprocess.has("right_handed") && preprocess["right_handed"].as<bool>();
+      data::PreprocessOptions::from(
+          config::Config::load((model_dir / "preparation.yaml").string()).root()["preprocess"])
+          .right_handed;
   const data::PrepareConfig config =
       bundled_config("configs/datasets/zeroad_bundled.yaml", "unused.h5");
   std::vector<datasets::Excluded> excluded;
