@@ -66,27 +66,20 @@ double ray_end(std::vector<std::pair<double, int>> crossings, LeafBoneOptions::E
 
 /// The `extended` construction (leaf_bones.hpp) on a validated mesh and skeleton.
 Eigen::MatrixXd tips_by_rays(const geometry::Mesh& mesh, const geometry::Skeleton& skeleton,
-                             double max_length, double coincident, LeafBoneOptions::End ends_at) {
+                             double max_length, double coincident, LeafBoneOptions::End ends_at,
+                             bool roots) {
   const aabb::TriangleTree triangles(mesh);
   const Tree& tree = triangles.tree();
   const std::vector<int> part = ends_at == LeafBoneOptions::End::kEnclosingParts
                                     ? geometry::vertex_parts(mesh)
                                     : std::vector<int>{};  // unused by first_surface
 
-  Eigen::MatrixXd tips = skeleton.positions;
-  const auto children = skeleton.children();
-  for (int j = 0; j < skeleton.num_joints(); ++j) {
-    if (!children[j].empty()) continue;
-    const Eigen::Vector3d leaf = skeleton.positions.row(j).transpose();
-    int a = skeleton.parents[j];
-    while (a >= 0 && (leaf - skeleton.positions.row(a).transpose()).norm() <= coincident) {
-      a = skeleton.parents[a];
-    }
-    if (a < 0) continue;  // a one-joint skeleton, or every ancestor at the leaf's position
-    const Eigen::Vector3d along = leaf - skeleton.positions.row(a).transpose();
+  // The end of the bone from `leaf` along `along` (the bone before it, whose length bounds it),
+  // or `leaf` itself when the ray meets nothing ahead.
+  const auto tip_along = [&](const Eigen::Vector3d& leaf,
+                             const Eigen::Vector3d& along) -> Eigen::Vector3d {
     const double parent_length = along.norm();
     const Eigen::Vector3d d = along / parent_length;
-
     std::vector<Tree::Intersection_and_primitive_id<Ray>::Type> hits;
     tree.all_intersections(Ray(point(leaf), point(leaf + d)), std::back_inserter(hits));
     std::vector<std::pair<double, int>> crossings;  // (distance along the ray, mesh part)
@@ -106,9 +99,32 @@ Eigen::MatrixXd tips_by_rays(const geometry::Mesh& mesh, const geometry::Skeleto
       if (!std::isfinite(t)) continue;
       crossings.emplace_back(t, part.empty() ? 0 : part[mesh.F(triangles.face(hit.second), 0)]);
     }
-    if (crossings.empty()) continue;  // nothing ahead: the joint is outside, facing away
+    if (crossings.empty()) return leaf;  // nothing ahead: the joint is outside, facing away
     const double end = ray_end(std::move(crossings), ends_at, coincident);
-    tips.row(j) = (leaf + std::min(end, max_length * parent_length) * d).transpose();
+    return leaf + std::min(end, max_length * parent_length) * d;
+  };
+
+  Eigen::MatrixXd tips = skeleton.positions;
+  const auto children = skeleton.children();
+  const auto joint = [&](int j) -> Eigen::Vector3d { return skeleton.positions.row(j).transpose(); };
+  for (int j = 0; j < skeleton.num_joints(); ++j) {
+    if (!children[j].empty()) continue;
+    int a = skeleton.parents[j];
+    while (a >= 0 && (joint(j) - joint(a)).norm() <= coincident) a = skeleton.parents[a];
+    if (a < 0) continue;  // a one-joint skeleton, or every ancestor at the leaf's position
+    tips.row(j) = tip_along(joint(j), joint(j) - joint(a)).transpose();
+  }
+  // A root with one child ends its chain as a leaf does: the same ray, from the root away from
+  // its child (the first descendant on the chain at another position).
+  const int r = skeleton.root();
+  if (roots && children[r].size() == 1) {
+    int c = children[r].front();
+    while ((joint(c) - joint(r)).norm() <= coincident && children[c].size() == 1) {
+      c = children[c].front();
+    }
+    if ((joint(c) - joint(r)).norm() > coincident) {
+      tips.row(r) = tip_along(joint(r), joint(r) - joint(c)).transpose();
+    }
   }
   return tips;
 }
@@ -133,6 +149,9 @@ LeafBoneOptions LeafBoneOptions::from(const config::Node& node) {
       .check(ends_at == "first_surface" || ends_at == "enclosing_parts", "ends_at",
              "must be 'first_surface' or 'enclosing_parts', got '" + ends_at + "'");
   if (ends_at == "enclosing_parts") o.ends_at = LeafBoneOptions::End::kEnclosingParts;
+  f.optional("roots", o.roots)
+      .check(!o.roots || o.kind == LeafBoneOptions::Kind::kExtended, "roots",
+             "needs 'type: extended' (the paper's helper bones have no extent to give a root)");
   f.finish();
   return o;
 }
@@ -143,7 +162,7 @@ std::string LeafBoneOptions::name() const {
 
 Eigen::MatrixXd extended_leaf_tips(const geometry::Mesh& mesh, const geometry::Skeleton& skeleton,
                                    double max_length, const std::string& source,
-                                   LeafBoneOptions::End ends_at) {
+                                   LeafBoneOptions::End ends_at, bool roots) {
   mesh.validate(source);
   skeleton.validate(source);
   if (!(max_length > 0)) {
@@ -153,7 +172,7 @@ Eigen::MatrixXd extended_leaf_tips(const geometry::Mesh& mesh, const geometry::S
   const double scale = (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).norm();
   const double coincident = leaf_geometry::kCoincident * std::max(scale, 1.0);
 
-  return leaf_geometry::tips_by_rays(mesh, skeleton, max_length, coincident, ends_at);
+  return leaf_geometry::tips_by_rays(mesh, skeleton, max_length, coincident, ends_at, roots);
 }
 
 void place_leaf_bones(const geometry::Mesh& mesh, geometry::Skeleton& skeleton,
@@ -163,7 +182,7 @@ void place_leaf_bones(const geometry::Mesh& mesh, geometry::Skeleton& skeleton,
     return;
   }
   skeleton.leaf_tips =
-      extended_leaf_tips(mesh, skeleton, options.max_length, source, options.ends_at);
+      extended_leaf_tips(mesh, skeleton, options.max_length, source, options.ends_at, options.roots);
 }
 
 }  // namespace skinlab::distances

@@ -47,9 +47,28 @@
 /// encloses the joint (an open mesh, a joint outside), the nearest crossing is kept. Measured
 /// with per-joint bone heat on every test set: results/tables/leaf_bones_enclosing_bone_heat.md.
 ///
+/// **Roots that end a chain** (`roots: true`; off by default and in every dataset prepared
+/// before 2026-12-07). A root with one child is the other end of a chain: a fish's first bone at
+/// its head, a tail-first chain, a hip joint with the spine as its only child. The region beyond
+/// it (the fish's head in front of the root) has no bone of its own: its nearest bone is the
+/// root's bone to its child, which it meets at that bone's end point, so every distance sees a
+/// vertex there as it sees one at the start of any other bone, whose weight usually belongs to
+/// the parent bone ending there. A model trained on skeletons whose roots sit in the middle of
+/// the body or outside it (0 A.D.'s ground root) gives that region to the next bone down the
+/// chain (the fish of the Quaternius packs, whose root is at the head, when that source is left
+/// out of training). With `roots`, such a root gets a helper bone by the same ray, from
+/// the root away from its child (the first descendant on the chain at another position), bounded
+/// by `max_length` × the root's bone; its tip is the root's row of Skeleton::leaf_tips
+/// (Skeleton::has_root_bone). The root's weight is then split between its two bones by the
+/// preprocessing's rule for a joint that starts several bones (the nearer one, data/preprocess.hpp),
+/// and both map back to the root joint. A root with no surface ahead (outside the mesh, facing
+/// away) keeps only its bone to the child, so the skeleton is as before. `leaf_bias`
+/// (models/branched_model.hpp) counts the root's helper bone as a leaf's: both end a chain.
+///
 /// The result is Skeleton::leaf_tips; bones, their order and the bone-level targets do not
-/// change (a leaf's weight is its helper bone's, data/preprocess.hpp), only the geometry that
-/// distances, binders and the bone attribute (Sec. 3.2) see.
+/// change (a leaf's weight is its helper bone's, data/preprocess.hpp) except for the root's
+/// helper bone of `roots`, only the geometry that distances, binders and the bone attribute
+/// (Sec. 3.2) see.
 
 #include <Eigen/Core>
 #include <string>
@@ -66,23 +85,25 @@ struct LeafBoneOptions {
   double max_length = 1.0;    ///< bound of an extended bone, × the parent bone's length; > 0
   enum class End { kFirstSurface, kEnclosingParts };
   End ends_at = End::kFirstSurface;  ///< where the ray ends (this file's comment)
+  bool roots = false;  ///< a helper bone for a root with one child (this file's comment)
 
   /// Decodes `leaf_bones: helper` / `leaf_bones: extended` or the map
-  /// `{type: extended, max_length: 1.0, ends_at: enclosing_parts}`; errors name the config
-  /// file, line and key.
+  /// `{type: extended, max_length: 1.0, ends_at: enclosing_parts, roots: true}`; errors name
+  /// the config file, line and key.
   static LeafBoneOptions from(const config::Node& node);
   /// "helper" or "extended".
   std::string name() const;
 };
 
 /// #J×3 leaf tips of `skeleton` on `mesh` (the `extended` construction above): row j is the tip
-/// of leaf joint j, and the joint's own position for every joint with children. Both in the same
-/// frame and units. Throws GeometryError (prefixed by `source`) for an invalid mesh or skeleton
-/// or `max_length` ≤ 0.
+/// of leaf joint j, and the joint's own position for every joint with children, except with
+/// `roots` the root's tip when it has one child and a surface ahead. Both in the same frame and
+/// units. Throws GeometryError (prefixed by `source`) for an invalid mesh or skeleton or
+/// `max_length` ≤ 0.
 Eigen::MatrixXd extended_leaf_tips(
     const geometry::Mesh& mesh, const geometry::Skeleton& skeleton, double max_length,
     const std::string& source,
-    LeafBoneOptions::End ends_at = LeafBoneOptions::End::kFirstSurface);
+    LeafBoneOptions::End ends_at = LeafBoneOptions::End::kFirstSurface, bool roots = false);
 
 /// Sets `skeleton.leaf_tips` as `options` asks: cleared for `helper`, extended_leaf_tips(...)
 /// for `extended`.

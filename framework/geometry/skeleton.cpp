@@ -33,6 +33,7 @@ std::vector<Bone> Skeleton::bones() const {
   std::vector<Bone> out;
   const int r = root();
   if (kids[r].empty()) return {Bone{r, r, true}};
+  if (has_root_bone()) out.push_back(Bone{r, r, true});
   std::deque<int> level{r};
   while (!level.empty()) {
     const int p = level.front();
@@ -44,6 +45,14 @@ std::vector<Bone> Skeleton::bones() const {
     }
   }
   return out;
+}
+
+bool Skeleton::has_root_bone() const {
+  if (leaf_tips.rows() != num_joints() || num_joints() < 2) return false;
+  const int r = root();
+  const double diagonal =
+      (positions.colwise().maxCoeff() - positions.colwise().minCoeff()).norm();
+  return (leaf_tips.row(r) - positions.row(r)).norm() > 1e-5 * diagonal;
 }
 
 Eigen::Vector3d Skeleton::bone_end(const Bone& b) const {

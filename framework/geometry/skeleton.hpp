@@ -14,7 +14,9 @@ namespace skinlab::geometry {
 /// bone added at every leaf joint "for skinning at the end of limbs" (HeterSkinNet Sec. 3.2;
 /// RigNet's virtual leaf bones): `start == end`. In the paper it has zero length; where
 /// Skeleton::leaf_tips is set it runs from the leaf joint to the leaf's tip
-/// (distances/leaf_bones.hpp).
+/// (distances/leaf_bones.hpp). A root with one child ends a chain as a leaf does; where its row of
+/// `leaf_tips` is set apart from the root (leaf_bones' `roots`), the root has a helper bone too,
+/// from the root to that tip (has_root_bone).
 struct Bone {
   int start = -1;
   int end = -1;
@@ -26,8 +28,8 @@ struct Skeleton {
   Eigen::MatrixXd positions;       ///< #J×3 joint positions in the mesh's frame
   std::vector<int> parents;        ///< #J parent joint index; -1 for the root
   /// #J×3 or empty. Empty: every helper bone has zero length (the paper). Set: the helper bone of
-  /// leaf joint j ends at row j (distances/leaf_bones.hpp); rows of joints with children are not
-  /// used (by convention the joint's own position).
+  /// leaf joint j ends at row j (distances/leaf_bones.hpp); rows of joints with children are the
+  /// joint's own position, except the root's where it has a helper bone (has_root_bone).
   Eigen::MatrixXd leaf_tips;
 
   int num_joints() const { return static_cast<int>(names.size()); }
@@ -40,8 +42,15 @@ struct Skeleton {
 
   /// Bones in RigNet's order (`get_bones` in its common_ops.py): breadth-first from the root;
   /// for each parent, one bone per child in index order, each followed by the helper bone of
-  /// that child if it is a leaf. A one-joint skeleton has a single helper bone.
+  /// that child if it is a leaf. A one-joint skeleton has a single helper bone. With a root
+  /// helper bone (has_root_bone, not in RigNet) that bone comes first.
   std::vector<Bone> bones() const;
+
+  /// True when the root has children and its row of `leaf_tips` lies apart from it (farther
+  /// than 1e-5 × the joints' bounding-box diagonal, so that rounding of a row that equals the
+  /// root never counts): the root then starts a helper bone to that tip, as a leaf does. Only
+  /// leaf_bones' `roots` option places such a tip (distances/leaf_bones.hpp).
+  bool has_root_bone() const;
 
   /// #B×6 rows [start xyz, end xyz] of `bones()`, the bone attribute of HeterSkinNet Sec. 3.2;
   /// a helper bone ends at its leaf tip when `leaf_tips` is set (bone_end).

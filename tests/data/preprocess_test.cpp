@@ -183,6 +183,31 @@ TEST(BoneWeights, BranchingJointGoesToNearestBone) {
   EXPECT_EQ(index.cols(), 4) << "K is capped at #B";
 }
 
+TEST(BoneWeights, ARootWithAHelperBoneGivesItsWeightToTheNearerOfItsTwoBones) {
+  // root(0) → a(1), the root's tip below it (leaf_bones' roots): bones (0,0 root helper), (0,1),
+  // (1,1 helper).
+  geometry::Skeleton s;
+  s.names = {"root", "a"};
+  s.parents = {-1, 0};
+  s.positions.resize(2, 3);
+  s.positions << 0, 1, 0, 0, 2, 0;
+  s.leaf_tips = s.positions;
+  s.leaf_tips.row(0) << 0, 0, 0;
+  s.leaf_tips.row(1) << 0, 3, 0;
+  ASSERT_TRUE(s.has_root_bone());
+  geometry::SparseWeights W(2, 2);
+  W.insert(0, 0) = 1.0;  // below the root
+  W.insert(1, 0) = 0.7;  // beside the root's bone to a
+  W.insert(1, 1) = 0.3;
+  Eigen::MatrixXd D(2, 3);
+  D << 0.1, 0.5, 1.5,
+       0.6, 0.2, 0.8;
+  const Eigen::MatrixXd B = data::bone_weights(W, s, D);
+  Eigen::MatrixXd expected(2, 3);
+  expected << 1.0, 0, 0, 0, 0.7, 0.3;
+  EXPECT_TRUE(B.isApprox(expected)) << B;
+}
+
 TEST(PreprocessLeaves, DroppedWeightlessEndJointsTakeTheirClipTransformsWithThem) {
   // OpenDungeons' Knight (bundled, with clips) with an extra weightless end joint under its first
   // leaf, in every clip too.

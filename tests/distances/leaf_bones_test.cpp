@@ -131,6 +131,74 @@ TEST(LeafBones, SkeletonSegmentsUseTheTipsAndHelperClearsThem) {
   EXPECT_LT(D_extended(top, 2), D_extended(top, 1));
 }
 
+TEST(LeafBones, ARootWithOneChildGetsAHelperBoneWithRoots) {
+  Column c;  // root at y = 0.5 inside the box, its only child above it at 1.5
+  using End = LeafBoneOptions::End;
+  const Eigen::MatrixXd without = extended_leaf_tips(c.mesh, c.skeleton, 1.0, "column");
+  EXPECT_TRUE(without.row(0).isApprox(c.skeleton.positions.row(0)));  // off by default
+  // From the root away from its child (-y) to the bottom face, 0.5 below: within 1 × the bone.
+  const Eigen::MatrixXd tips =
+      extended_leaf_tips(c.mesh, c.skeleton, 1.0, "column", End::kFirstSurface, true);
+  EXPECT_NEAR(tips(0, 1), 0.0, 1e-9);
+  EXPECT_NEAR(tips(0, 0), 0.0, 1e-12);
+  EXPECT_NEAR(tips(2, 1), 3.5, 1e-9);  // the leaf as before
+  EXPECT_TRUE(tips.row(1).isApprox(c.skeleton.positions.row(1)));
+  // Bounded as a leaf's bone is: 0.25 × the root's bone.
+  EXPECT_NEAR(extended_leaf_tips(c.mesh, c.skeleton, 0.25, "column", End::kFirstSurface, true)(0, 1),
+              0.25, 1e-12);
+
+  // The skeleton's bones: the root's helper bone first, then RigNet's order.
+  EXPECT_FALSE(c.skeleton.has_root_bone());
+  place_leaf_bones(c.mesh, c.skeleton, parse("leaf_bones: {type: extended, roots: true}"), "c");
+  ASSERT_TRUE(c.skeleton.has_root_bone());
+  const auto bones = c.skeleton.bones();
+  ASSERT_EQ(bones.size(), 4u);  // root helper, j0->j1, j1->j2, helper at j2
+  EXPECT_TRUE(bones[0].helper);
+  EXPECT_EQ(bones[0].start, 0);
+  EXPECT_EQ(bones[1].end, 1);
+  EXPECT_TRUE(bones[3].helper);
+  EXPECT_EQ(bones[3].start, 2);
+  const Eigen::MatrixXd seg = c.skeleton.bone_segments();
+  EXPECT_NEAR(seg(0, 1), 0.5, 1e-12);
+  EXPECT_NEAR(seg(0, 4), 0.0, 1e-9);
+  // A vertex below the root is nearer to the root's own bone than to its bone to the child.
+  const auto euclidean =
+      distance_registry().create(config::Config::parse("{type: euclidean}", "d.yaml").root());
+  const Eigen::MatrixXd D = euclidean->compute(c.mesh, c.skeleton);
+  const int bottom = testing::nearest_vertex(c.mesh, {0, 0, 0});
+  EXPECT_LT(D(bottom, 0), D(bottom, 1));
+  // A tip within rounding of the root is no bone.
+  c.skeleton.leaf_tips.row(0) = c.skeleton.positions.row(0) * (1 + 1e-12);
+  EXPECT_FALSE(c.skeleton.has_root_bone());
+  EXPECT_EQ(c.skeleton.bones().size(), 3u);
+}
+
+TEST(LeafBones, RootsInTheMiddleOrOutsideGetNoHelperBone) {
+  using End = LeafBoneOptions::End;
+  Column c;
+  // A second child of the root (a leg below the hip): the root is inside a chain, not its end.
+  c.skeleton.names.push_back("leg");
+  c.skeleton.parents.push_back(0);
+  c.skeleton.positions.conservativeResize(4, 3);
+  c.skeleton.positions.row(3) << 0, 0.2, 0;
+  EXPECT_TRUE(extended_leaf_tips(c.mesh, c.skeleton, 1.0, "c", End::kFirstSurface, true)
+                  .row(0)
+                  .isApprox(c.skeleton.positions.row(0)));
+  // A root below the box facing away from it (a ground root under the feet): nothing ahead.
+  Column outside;
+  outside.skeleton.positions(0, 1) = -0.5;
+  place_leaf_bones(outside.mesh, outside.skeleton,
+                   parse("leaf_bones: {type: extended, roots: true}"), "c");
+  EXPECT_FALSE(outside.skeleton.has_root_bone());
+  EXPECT_EQ(outside.skeleton.bones().size(), 3u);
+  // A child at the root's position: the direction is the next joint's on the chain.
+  Column coincident;
+  coincident.skeleton.positions.row(1) = coincident.skeleton.positions.row(0);
+  EXPECT_NEAR(extended_leaf_tips(coincident.mesh, coincident.skeleton, 1.0, "c",
+                                 End::kFirstSurface, true)(0, 1),
+              0.0, 1e-9);
+}
+
 TEST(LeafBones, Options) {
   EXPECT_EQ(parse("x: 1").kind, LeafBoneOptions::Kind::kHelper);  // absent: the paper
   EXPECT_EQ(parse("leaf_bones: helper").kind, LeafBoneOptions::Kind::kHelper);
@@ -141,6 +209,10 @@ TEST(LeafBones, Options) {
   EXPECT_EQ(o.ends_at, LeafBoneOptions::End::kFirstSurface);  // absent: every earlier dataset
   EXPECT_EQ(parse("leaf_bones: {type: extended, ends_at: enclosing_parts}").ends_at,
             LeafBoneOptions::End::kEnclosingParts);
+  EXPECT_FALSE(parse("leaf_bones: {type: extended}").roots);
+  EXPECT_TRUE(parse("leaf_bones: {type: extended, roots: true}").roots);
+  expect_error<ConfigError>([] { parse("leaf_bones: {type: helper, roots: true}"); },
+                            {"roots", "type: extended"});
   expect_error<ConfigError>([] { parse("leaf_bones: {type: extended, ends_at: last}"); },
                             {"ends_at", "'first_surface'", "'enclosing_parts'", "last"});
   expect_error<ConfigError>([] { parse("leaf_bones: longer"); },
