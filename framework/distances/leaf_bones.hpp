@@ -51,19 +51,19 @@
 /// before 2026-12-07). A root with one child is the other end of a chain: a fish's first bone at
 /// its head, a tail-first chain, a hip joint with the spine as its only child. The region beyond
 /// it (the fish's head in front of the root) has no bone of its own: its nearest bone is the
-/// root's bone to its child, which it meets at that bone's end point, so every distance sees a
-/// vertex there as it sees one at the start of any other bone, whose weight usually belongs to
-/// the parent bone ending there. A model trained on skeletons whose roots sit in the middle of
-/// the body or outside it (0 A.D.'s ground root) gives that region to the next bone down the
-/// chain (the fish of the Quaternius packs, whose root is at the head, when that source is left
-/// out of training). With `roots`, such a root gets a helper bone by the same ray, from
-/// the root away from its child (the first descendant on the chain at another position), bounded
-/// by `max_length` × the root's bone; its tip is the root's row of Skeleton::leaf_tips
-/// (Skeleton::has_root_bone). The root's weight is then split between its two bones by the
-/// preprocessing's rule for a joint that starts several bones (the nearer one, data/preprocess.hpp),
-/// and both map back to the root joint. A root with no surface ahead (outside the mesh, facing
-/// away) keeps only its bone to the child, so the skeleton is as before. `leaf_bias`
+/// root's bone to its child, which it meets at that bone's end point, as a vertex at the start of
+/// any other bone meets it, where the weight usually belongs to the parent bone ending there.
+/// With `roots`, such a root gets a helper bone by the same ray, from the root away from its
+/// child (the first descendant on the chain at another position), bounded by `max_length` × the
+/// root's bone; its tip is the root's row of Skeleton::leaf_tips (Skeleton::has_root_bone). The
+/// root's weight is then split between its two bones by the preprocessing's rule for a joint
+/// that starts several bones (the nearer one, data/preprocess.hpp), and both map back to the
+/// root joint. A root with no surface ahead (outside the mesh, facing away, as 0 A.D.'s ground
+/// roots) keeps only its bone to the child, so the skeleton is as before. `leaf_bias`
 /// (models/branched_model.hpp) counts the root's helper bone as a leaf's: both end a chain.
+/// Measured with the Quaternius packs left out of training (their fish have the root at the
+/// head; results/tables/loso_quaternius_roots.md): a model trained with root bones skins the
+/// fish worse than one trained without, so no model uses the option.
 ///
 /// The result is Skeleton::leaf_tips; bones, their order and the bone-level targets do not
 /// change (a leaf's weight is its helper bone's, data/preprocess.hpp) except for the root's
