@@ -352,7 +352,7 @@ train::TrainResult SequenceTrainer::fit(const RunDir& run, const train::FitLimit
   at::Generator torch_rng = at::detail::getDefaultCPUGenerator();
   at::Generator order_rng =
       at::make_generator<at::CPUGeneratorImpl>(train::order_seed(options_.run.seed));
-  train::FitStart begun = train::start_fit(run, model(), *optimizer_, options_.run.seed,
+  train::FitStart begun = train::start_fit(run, model(), *optimizer_, options_.run.seed, t,
                                            options_.run.model.to_yaml(), torch_rng, order_rng,
                                            initial_torch_rng_);
   train::TrainingState& state = begun.state;
@@ -365,13 +365,10 @@ train::TrainResult SequenceTrainer::fit(const RunDir& run, const train::FitLimit
                  options_.sequences.data.val_fraction > 0 ? " of 2 frames or more"
                                                           : " (sequences.val_fraction is 0)");
   }
-  auto stopped_early = [&] {
-    return t.patience > 0 && state.best_epoch > 0 && state.epoch - state.best_epoch >= t.patience;
-  };
   model().train();
   const auto session_start = Clock::now();
   const int iterations = options_.sequences.iterations_per_epoch;
-  while (state.epoch < t.epochs && !stopped_early()) {
+  while (!train::finished(state, t)) {
     const std::int64_t epoch = state.epoch + 1;
     const auto epoch_start = Clock::now();
     const std::string label = fmt::format("epoch {}/{}", epoch, t.epochs);
@@ -421,7 +418,7 @@ train::TrainResult SequenceTrainer::fit(const RunDir& run, const train::FitLimit
       break;
     }
   }
-  train::finish_fit(result, state, t, stopped_early(), start);
+  train::finish_fit(result, state, t, train::stopped_early(state, t), start);
   return result;
 }
 

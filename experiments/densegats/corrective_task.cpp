@@ -204,7 +204,7 @@ train::TrainResult CorrectiveTrainer::fit(const RunDir& run, const train::FitLim
   at::Generator torch_rng = at::detail::getDefaultCPUGenerator();
   at::Generator order_rng =
       at::make_generator<at::CPUGeneratorImpl>(train::order_seed(options_.run.seed));
-  train::FitStart begun = train::start_fit(run, *model_, *optimizer_, options_.run.seed,
+  train::FitStart begun = train::start_fit(run, *model_, *optimizer_, options_.run.seed, t,
                                            options_.run.model.to_yaml(), torch_rng, order_rng,
                                            initial_torch_rng_);
   train::TrainingState& state = begun.state;
@@ -222,13 +222,10 @@ train::TrainResult CorrectiveTrainer::fit(const RunDir& run, const train::FitLim
   }
   const bool have_val = !validation_.empty();
   if (!have_val) spdlog::warn("no validation character: best.pt and early stopping use the train loss");
-  auto stopped_early = [&] {
-    return t.patience > 0 && state.best_epoch > 0 && state.epoch - state.best_epoch >= t.patience;
-  };
 
   model_->train();
   const auto session_start = Clock::now();
-  while (state.epoch < t.epochs && !stopped_early()) {
+  while (!train::finished(state, t)) {
     const std::int64_t epoch = state.epoch + 1;
     const auto epoch_start = Clock::now();
     const std::string label = fmt::format("epoch {}/{}", epoch, t.epochs);
@@ -295,7 +292,7 @@ train::TrainResult CorrectiveTrainer::fit(const RunDir& run, const train::FitLim
       break;
     }
   }
-  train::finish_fit(result, state, t, stopped_early(), start);
+  train::finish_fit(result, state, t, train::stopped_early(state, t), start);
   return result;
 }
 

@@ -103,8 +103,18 @@ void finish_fit(TrainResult& result, const TrainingState& state, const TrainOpti
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+bool stopped_early(const TrainingState& state, const TrainOptions& options) {
+  return options.patience > 0 && state.best_epoch > 0 &&
+         state.epoch - state.best_epoch >= options.patience;
+}
+
+bool finished(const TrainingState& state, const TrainOptions& options) {
+  return state.epoch >= options.epochs || stopped_early(state, options);
+}
+
 FitStart start_fit(const RunDir& run, torch::nn::Module& model, torch::optim::Optimizer& optimizer,
-                   std::int64_t seed, const std::string& model_config, at::Generator& torch_rng,
+                   std::int64_t seed, const TrainOptions& options, const std::string& model_config,
+                   at::Generator& torch_rng,
                    at::Generator& order_rng, const torch::Tensor& initial_torch_rng, bool writer) {
   if (writer) remove_stale_temporaries(run);
   FitStart start;
@@ -131,7 +141,7 @@ FitStart start_fit(const RunDir& run, torch::nn::Module& model, torch::optim::Op
     set_rng_state(torch_rng, saved.torch_rng);
     set_rng_state(order_rng, saved.order_rng);
     start.resumed = true;
-    if (writer) {
+    if (writer && !finished(state, options)) {
       const GitState& git = build_git_state();
       run.record_resume({{"after_epoch", state.epoch},
                          {"git_commit", git.commit},
@@ -141,6 +151,10 @@ FitStart start_fit(const RunDir& run, torch::nn::Module& model, torch::optim::Op
     }
     spdlog::info("resuming {} after epoch {} (best epoch {}, loss {:.6g})", run.path().string(),
                  state.epoch, state.best_epoch, state.best_loss);
+    if (writer && finished(state, options)) {
+      spdlog::info("nothing to train: the run has finished ({} epochs{})", state.epoch,
+                   stopped_early(state, options) ? ", stopped early" : "");
+    }
   } else {
     set_rng_state(torch_rng, initial_torch_rng);
   }

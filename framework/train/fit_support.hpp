@@ -50,6 +50,12 @@ void truncate_metrics(const RunDir& run, std::int64_t epoch);
 /// or below best_loss − min_delta), best_epoch and best_loss. Returns whether it improved.
 bool record_epoch(TrainingState& state, std::int64_t epoch, double selection, double min_delta);
 
+/// Whether `state` ends a fit early: patience > 0 and no improvement for `patience` epochs after
+/// the best one.
+bool stopped_early(const TrainingState& state, const TrainOptions& options);
+/// Whether a run in `state` has nothing left to train: all `options.epochs` done, or stopped early.
+bool finished(const TrainingState& state, const TrainOptions& options);
+
 /// How a fit starts (`start_fit`): the state to continue from, and whether it came from last.pt.
 struct FitStart {
   TrainingState state;  ///< epoch and best counters restored; seed, threads, model config set
@@ -61,10 +67,13 @@ struct FitStart {
 /// last.pt, loads it into `model` and `optimizer` (Error for another seed than `seed`, a warning
 /// for another thread count), restores both generators and the epoch and best counters and logs
 /// it; otherwise resets `torch_rng` to `initial_torch_rng`. Then drops metrics.jsonl records past
-/// the restored epoch. A process that does not write the run (`writer` false: ranks other than 0
-/// of a distributed run) only reads: it neither removes temporaries nor truncates metrics.
+/// the restored epoch. A resume is recorded in env.json only when `options` leave epochs to
+/// train: opening a finished run (a sweep run again) changes none of its files. A process that
+/// does not write the run (`writer` false: ranks other than 0 of a distributed run) only reads:
+/// it neither removes temporaries nor truncates metrics.
 FitStart start_fit(const RunDir& run, torch::nn::Module& model, torch::optim::Optimizer& optimizer,
-                   std::int64_t seed, const std::string& model_config, at::Generator& torch_rng,
+                   std::int64_t seed, const TrainOptions& options, const std::string& model_config,
+                   at::Generator& torch_rng,
                    at::Generator& order_rng, const torch::Tensor& initial_torch_rng,
                    bool writer = true);
 

@@ -194,7 +194,7 @@ TrainResult Trainer::fit(const RunDir& run, const FitLimits& limits) {
   at::Generator order_rng = at::make_generator<at::CPUGeneratorImpl>(order_seed(options_.seed));
 
   const bool writer = world_->writer();
-  FitStart begun = start_fit(run, *model_, *optimizer_, options_.seed, options_.model.to_yaml(),
+  FitStart begun = start_fit(run, *model_, *optimizer_, options_.seed, t, options_.model.to_yaml(),
                              torch_rng, order_rng, initial_torch_rng_, writer);
   world_->broadcast_parameters(*model_);
   TrainingState& state = begun.state;
@@ -218,13 +218,6 @@ TrainResult Trainer::fit(const RunDir& run, const FitLimits& limits) {
       t.max_characters_per_epoch > 0
           ? std::min<std::size_t>(train.size(), static_cast<std::size_t>(t.max_characters_per_epoch))
           : train.size();
-  auto stopped_early = [&] {
-    return t.patience > 0 && state.best_epoch > 0 && state.epoch - state.best_epoch >= t.patience;
-  };
-  if (state.epoch >= t.epochs || stopped_early()) {
-    spdlog::info("nothing to train: the run has finished ({} epochs{})", state.epoch,
-                 stopped_early() ? ", stopped early" : "");
-  }
 
   // Test hook (tests/cli): SKINLAB_TEST_KILL="<rank>:<steps>" makes that rank kill itself
   // after <steps> optimiser steps, as a crashed worker would.
@@ -237,7 +230,7 @@ TrainResult Trainer::fit(const RunDir& run, const FitLimits& limits) {
 
   model_->train();
   const auto session_start = Clock::now();
-  while (state.epoch < t.epochs && !stopped_early()) {
+  while (!finished(state, t)) {
     const std::int64_t epoch = state.epoch + 1;
     const auto epoch_start = Clock::now();
     const torch::Tensor order = torch::randperm(static_cast<std::int64_t>(train.size()), order_rng,
@@ -317,7 +310,7 @@ TrainResult Trainer::fit(const RunDir& run, const FitLimits& limits) {
       break;
     }
   }
-  finish_fit(result, state, t, stopped_early(), start);
+  finish_fit(result, state, t, stopped_early(state, t), start);
   return result;
 }
 

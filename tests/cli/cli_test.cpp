@@ -567,6 +567,15 @@ TEST(Cli, DenseGatsSmokeSweepOnTheBundledBipeds) {
   EXPECT_NE(nf.err.find("no saved predictions for part 'test'"), std::string::npos) << nf.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "figures2" / "README.md"));
 
+  // Run again with its checkpoints, the finished network trains nothing and keeps its saved
+  // evaluation byte for byte instead of being evaluated again.
+  const std::string net_eval = read_file(net / "eval_test.json");
+  const std::string net_env = read_file(net / "env.json");
+  const Result finished = run("sweep " + (dir / "sweep.yaml").string());
+  ASSERT_EQ(finished.status, 0) << finished.err;
+  EXPECT_NE(finished.out.find("saved evaluation kept"), std::string::npos) << finished.out;
+  EXPECT_EQ(read_file(net / "eval_test.json"), net_eval);
+  EXPECT_EQ(read_file(net / "env.json"), net_env);
   // A committed run keeps its evaluation but not its checkpoints: the sweep uses the saved
   // evaluation instead of training it again; without that either, it refuses to retrain.
   for (const char* pt : {"best.pt", "last.pt"}) std::filesystem::remove(net / pt);

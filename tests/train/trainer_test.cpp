@@ -222,6 +222,9 @@ TEST_F(Training, EarlyStoppingAndResumingAFinishedRun) {
   EXPECT_EQ(s.epochs_this_call, 0);
   EXPECT_EQ(s.epochs, 3);
   EXPECT_EQ(run_dir(results_.path(), "a").read_metrics().size(), 3u);
+  // Opening a finished run trains nothing and so records no resume.
+  EXPECT_FALSE(nlohmann::json::parse(read_file(run_dir(results_.path(), "a").file("env.json")))
+                   .contains("resumes"));
 }
 
 TEST_F(Training, MaxCharactersPerEpochAndNoValidationPart) {
