@@ -26,8 +26,9 @@
 ///
 /// A sweep can be interrupted and run again: an entry whose run directory exists continues
 /// (training resumes from last.pt and the run is evaluated after it; a finished run that trains
-/// no further epoch keeps its saved evaluation and is only evaluated if that is missing), provided the resolved config is unchanged; a changed config is an error naming
-/// the run, so results are never mixed. Like `skinlab train` and `skinlab eval`, a sweep holds
+/// no further epoch keeps its saved evaluation and is only evaluated if that is missing),
+/// provided the resolved config is unchanged; a changed config is an error naming the run, so
+/// results are never mixed. Like `skinlab train` and `skinlab eval`, a sweep holds
 /// an entry's `train.lock` while training it and `eval_<part>.lock` while evaluating it
 /// (core/output_lock.hpp), so a sweep and another process never write the same run at once.
 ///
@@ -239,7 +240,8 @@ fs::path run_entry(const Sweep& sweep, const Entry& entry, int threads) {
     // A finished run that trained nothing now keeps its evaluation: evaluating the same
     // checkpoint again would only rewrite eval_<part>.* and env.json with values that differ in
     // the last digits (another thread count), which is noise in a committed run.
-    if (existed && r.epochs_this_call == 0 && fs::exists(run.file("eval_" + sweep.part + ".json"))) {
+    if (existed && r.epochs_this_call == 0 &&
+        fs::exists(run.file("eval_" + sweep.part + ".json"))) {
       std::cout << fmt::format("   finished after {} epochs; saved evaluation kept\n", r.epochs);
       return run.path();
     }
