@@ -57,6 +57,8 @@
 /// `keep_prior_outside: true` changes only evaluation and prediction: the prior keeps its own
 /// weight on the bones outside the K candidates and the candidates share the prior's mass on
 /// them as w_v says (infer::keep_prior_outside), so a zero head reproduces the prior itself.
+/// `prior_mix: α` (evaluation and prediction only) then returns (1 − α)·w + α·p, the network's
+/// bone weights mixed with the prior's (infer::mix_prior), for sources the network has not seen.
 ///
 /// Ablations are configs: `configs/ablations/no_heterconv.yaml` lists `local`/`stem` without the
 /// `b2v`/`v2b` ops (the head still reads the K candidates' bone features: without an

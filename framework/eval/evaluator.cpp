@@ -139,7 +139,7 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
   std::shared_ptr<models::Model> model;
   std::shared_ptr<binders::Binder> binder;
   std::string method_type, prior_type;
-  std::string prior_outside;  // the prior whose weight off the candidates a model's rows keep
+  infer::PriorUse prior_use;  // what a model's rows do with its prior after the network
   std::int64_t epoch = 0;
   std::unique_ptr<losses::LossSum> loss;
   if (is_binder) {
@@ -151,7 +151,8 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
     }
   } else {
     model = train::build_model(o);
-    prior_outside = models::PriorOptions::of(o.model).outside();
+    const models::PriorOptions prior = models::PriorOptions::of(o.model);
+    prior_use = {prior.prior, prior.keep_prior_outside, prior.prior_mix};
     epoch = train::load_checkpoint(checkpoint, *model).epoch;
     loss = std::make_unique<losses::LossSum>(losses::LossSum::from(o.losses));
     model->eval();
@@ -211,9 +212,9 @@ EvalReport evaluate(const RunDir& run, const EvalOptions& options) {
       candidates = model->forward(c);
       train::check_prediction(candidates, c, o);
       weights = network_weights = data::scatter_to_bones(candidates, c.topk_index, c.num_bones());
-      if (!prior_outside.empty()) {
+      if (prior_use.acts()) {
         data::RowMatrixXd W = to_eigen(weights).cast<double>();
-        infer::keep_prior_outside(W, character, o.data.distance, prior_outside);
+        infer::use_prior(W, character, o.data.distance, prior_use);
         weights = data::to_float(W);
       }
     }

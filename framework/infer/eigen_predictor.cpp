@@ -113,9 +113,9 @@ Prediction EigenPredictor::predict(const geometry::Character& character,
   const auto start = std::chrono::steady_clock::now();
   data::RowMatrixXf candidates = forward(network_, input.prepared, distance_);
   if (times != nullptr) times->network += seconds_since(start);
-  const std::string prior_outside = network_.keep_prior_outside() ? network_.prior() : "";
+  const PriorUse prior{network_.prior(), network_.keep_prior_outside(), network_.prior_mix()};
   return finish_prediction(std::move(input), distance_, std::move(candidates), options.prune,
-                           prior_outside, times);
+                           prior, times);
 }
 
 }  // namespace skinlab::infer

@@ -648,6 +648,7 @@ struct Network::Impl {
   bool prior_bias = false;
   float prior_epsilon = 0;
   bool keep_prior_outside = false;
+  double prior_mix = 0;
   float leaf_bias = 0;  ///< models::BranchedModelOptions::leaf_bias
   double distance_unit = 1.0 / 88.0, min_distance = 1.0;
   std::vector<std::unique_ptr<Op>> stem, local;
@@ -664,6 +665,7 @@ Network::~Network() = default;
 int Network::top_k() const { return static_cast<int>(impl_->top_k); }
 const std::string& Network::prior() const { return impl_->prior; }
 bool Network::keep_prior_outside() const { return impl_->keep_prior_outside; }
+double Network::prior_mix() const { return impl_->prior_mix; }
 
 Network Network::from(const ParameterFile& parameters, const fs::path& file) {
 #if defined(__AVX2__) && defined(__FMA__)
@@ -691,6 +693,13 @@ Network Network::from(const ParameterFile& parameters, const fs::path& file) {
     // Parameter files written before keep_prior_outside existed do not have it: false.
     if (arch.contains("keep_prior_outside")) {
       impl->keep_prior_outside = s.value<bool>(arch, "keep_prior_outside", "the architecture");
+    }
+    // Written only when not 0 (and never before prior_mix existed).
+    if (arch.contains("prior_mix")) {
+      impl->prior_mix = s.value<double>(arch, "prior_mix", "the architecture");
+      if (!(impl->prior_mix >= 0 && impl->prior_mix <= 1)) {
+        s.fail(fmt::format("architecture: prior_mix must be in [0, 1], got {}", impl->prior_mix));
+      }
     }
   }
   impl->top_k = s.value<Index>(arch, "top_k", "the architecture");

@@ -83,6 +83,9 @@ class Network {
   /// Whether predictions keep the prior's weight off the candidates
   /// (models::PriorOptions::keep_prior_outside, infer::keep_prior_outside); false without a prior.
   bool keep_prior_outside() const;
+  /// α of the mix with the prior after the network (models::PriorOptions::prior_mix,
+  /// infer::mix_prior); 0 without a prior.
+  double prior_mix() const;
 
   Network(Network&&) noexcept;
   Network& operator=(Network&&) noexcept;

@@ -36,6 +36,25 @@ geometry::SparseWeights onto_input_joints(const geometry::SparseWeights& W,
   return out;
 }
 
+/// `character`'s prior `prior` (#V×#B), checked to be as large as `W`; Error naming the
+/// character and `what` (the option that needs it) otherwise.
+const data::RowMatrixXf& prior_like(const data::RowMatrixXd& W,
+                                    const data::PreparedCharacter& character,
+                                    const std::string& prior, const char* what) {
+  const auto it = character.priors.find(prior);
+  if (it == character.priors.end()) {
+    throw Error(fmt::format("{}: {} needs the '{}' prior, which the character was not prepared "
+                            "with (preprocess.priors: [{{type: {}}}])",
+                            character.name, what, prior, prior));
+  }
+  const data::RowMatrixXf& P = it->second;
+  if (P.rows() != W.rows() || P.cols() != W.cols()) {
+    throw Error(fmt::format("{}: the '{}' prior is {}×{}, the bone weights {}×{}", character.name,
+                            prior, P.rows(), P.cols(), W.rows(), W.cols()));
+  }
+  return P;
+}
+
 }  // namespace
 
 std::vector<int> check_predictable(const geometry::Character& c, const PredictOptions& options) {
@@ -170,19 +189,11 @@ PreparedInput prepare_to_predict(const geometry::Character& character,
 
 void keep_prior_outside(data::RowMatrixXd& W, const data::PreparedCharacter& character,
                         const std::string& distance, const std::string& prior) {
-  const auto it = character.priors.find(prior);
-  if (it == character.priors.end()) {
-    throw Error(fmt::format("{}: keep_prior_outside needs the '{}' prior, which the character "
-                            "was not prepared with (preprocess.priors: [{{type: {}}}])",
-                            character.name, prior, prior));
-  }
-  const data::RowMatrixXf& P = it->second;
+  const data::RowMatrixXf& P = prior_like(W, character, prior, "keep_prior_outside");
   const data::RowMatrixXi& topk = character.distances.at(distance).topk_index;
-  if (P.rows() != W.rows() || P.cols() != W.cols() || topk.rows() != W.rows()) {
-    throw Error(fmt::format("{}: the '{}' prior is {}×{} and its candidates {}×{}, the bone "
-                            "weights {}×{}",
-                            character.name, prior, P.rows(), P.cols(), topk.rows(), topk.cols(),
-                            W.rows(), W.cols()));
+  if (topk.rows() != W.rows()) {
+    throw Error(fmt::format("{}: {} candidates for {} vertices of bone weights", character.name,
+                            topk.rows(), W.rows()));
   }
   for (Eigen::Index v = 0; v < W.rows(); ++v) {
     double mass = 0;  // m_v: the prior's weight on v's candidates
@@ -196,9 +207,25 @@ void keep_prior_outside(data::RowMatrixXd& W, const data::PreparedCharacter& cha
   }
 }
 
+void mix_prior(data::RowMatrixXd& W, const data::PreparedCharacter& character,
+               const std::string& prior, double alpha) {
+  if (!(alpha >= 0 && alpha <= 1)) {
+    throw Error(fmt::format("{}: prior_mix must be in [0, 1], got {}", character.name, alpha));
+  }
+  const data::RowMatrixXf& P = prior_like(W, character, prior, "prior_mix");
+  W = (1 - alpha) * W + alpha * P.cast<double>();
+}
+
+void use_prior(data::RowMatrixXd& W, const data::PreparedCharacter& character,
+               const std::string& distance, const PriorUse& use) {
+  if (!use.acts()) return;
+  if (use.keep_outside) keep_prior_outside(W, character, distance, use.prior);
+  if (use.mix > 0) mix_prior(W, character, use.prior, use.mix);
+}
+
 Prediction finish_prediction(PreparedInput input, const std::string& distance,
                              data::RowMatrixXf candidates, double prune,
-                             const std::string& prior_outside, StageTimes* times) {
+                             const PriorUse& prior, StageTimes* times) {
   const auto start = Clock::now();
   const data::PreparedCharacter& prepared = input.prepared;
   const data::DistanceData& d = prepared.distances.at(distance);
@@ -222,7 +249,7 @@ Prediction finish_prediction(PreparedInput input, const std::string& distance,
       W(v, d.topk_index(v, k)) = w;
     }
   }
-  if (!prior_outside.empty()) keep_prior_outside(W, prepared, distance, prior_outside);
+  use_prior(W, prepared, distance, prior);
   if (times != nullptr) times->network += seconds_since(start);
   Prediction out = finish_bone_weights(std::move(input), distance, std::move(W), prune,
                                        "the network", times);

@@ -134,16 +134,41 @@ PreparedInput prepare_to_predict(const geometry::Character& character,
 void keep_prior_outside(data::RowMatrixXd& W, const data::PreparedCharacter& character,
                         const std::string& distance, const std::string& prior);
 
+/// A model's bone weights mixed with a prior's (models::PriorOptions::prior_mix; not in the
+/// papers): W ← (1 − α)·W + α·P for `character`'s prior `prior` P (#V×#B, as W), α = `alpha`
+/// in [0, 1]. Rows that sum to 1 still do. A convex combination of the learned weights and the
+/// classical method's, chosen on characters from sources the network did not train on: where
+/// the network has not seen a source, it errs differently from the prior, and the mix errs less
+/// than either. Throws Error naming the character when it has no such prior or its shape
+/// differs.
+void mix_prior(data::RowMatrixXd& W, const data::PreparedCharacter& character,
+               const std::string& prior, double alpha);
+
+/// What evaluation and prediction do with a model's prior after its forward pass (the fields
+/// of models::PriorOptions that act there): keep it off the candidates, then mix it in.
+struct PriorUse {
+  std::string prior;          ///< a key of PreparedCharacter::priors; empty: the model reads none
+  bool keep_outside = false;  ///< keep_prior_outside
+  double mix = 0;             ///< mix_prior's α; 0: the model's weights alone
+
+  /// Whether use_prior changes a model's weights.
+  bool acts() const { return !prior.empty() && (keep_outside || mix > 0); }
+};
+
+/// `W` (#V×#B, the model's weights scattered to bones) completed as `use` says: keep_prior_outside
+/// when `use.keep_outside`, then mix_prior when `use.mix` > 0; unchanged unless `use.acts()`.
+void use_prior(data::RowMatrixXd& W, const data::PreparedCharacter& character,
+               const std::string& distance, const PriorUse& use);
+
 /// Step 4: `candidates` (#V×K, the network's softmax over `input.prepared`'s candidates of
-/// `distance`) scattered to bones, completed with the prior `prior_outside` off the candidates
-/// when that is not empty (keep_prior_outside), pruned, checked (every vertex keeps a weight)
+/// `distance`) scattered to bones, completed with the model's prior as `prior` says (use_prior),
+/// pruned, checked (every vertex keeps a weight)
 /// and mapped back to the input's vertices and joints; `input.prepared` moves into the result.
 /// Throws Error naming the character and the vertex for a non-finite or negative output or a
 /// vertex left without weight. `times->map_back` receives the mapping back.
 Prediction finish_prediction(PreparedInput input, const std::string& distance,
                              data::RowMatrixXf candidates, double prune,
-                             const std::string& prior_outside = "",
-                             StageTimes* times = nullptr);
+                             const PriorUse& prior = {}, StageTimes* times = nullptr);
 
 /// Step 4 for weights that are already per bone: `W` (#V×#B at `input.prepared`'s vertices,
 /// from `method`, e.g. "binder 'bone_heat'", which error messages name) checked (finite, ≥ 0),

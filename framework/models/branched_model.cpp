@@ -32,9 +32,12 @@ void PriorOptions::read(config::Fields& f) {
   f.optional("prior_bias", prior_bias);
   f.optional("prior_epsilon", prior_epsilon);
   f.optional("keep_prior_outside", keep_prior_outside);
+  f.optional("prior_mix", prior_mix);
   f.check(prior_epsilon > 0, "prior_epsilon", "must be positive");
   f.check(!prior_bias || !prior.empty() || !bias_given, "prior_bias", "needs a `prior`");
   f.check(!keep_prior_outside || !prior.empty(), "keep_prior_outside", "needs a `prior`");
+  f.check(prior_mix >= 0 && prior_mix <= 1, "prior_mix", "must be in [0, 1]");
+  f.check(prior_mix == 0 || !prior.empty(), "prior_mix", "needs a `prior`");
 }
 
 PriorOptions PriorOptions::of(const config::Node& model) {

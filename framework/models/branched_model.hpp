@@ -63,14 +63,15 @@ struct PriorOptions {
   /// (infer::keep_prior_outside). With `prior_bias`, a head of zeros then reproduces the prior
   /// itself instead of the prior renormalised over the candidates. Needs `prior`.
   bool keep_prior_outside = false;
+  /// Evaluation and prediction only: α in [0, 1] of the mix (1 − α)·model + α·prior of the
+  /// bone weights, after keep_prior_outside and before pruning (infer::mix_prior); 0: the
+  /// model's weights alone. Needs `prior` when above 0.
+  double prior_mix = 0;
 
-  /// The prior whose weight off the candidates evaluation and prediction keep: `prior` with
-  /// keep_prior_outside, else empty (infer::finish_prediction's `prior_outside`).
-  std::string outside() const { return keep_prior_outside ? prior : std::string(); }
-
-  /// Reads and checks `prior`, `prior_bias`, `prior_epsilon` and `keep_prior_outside` from `f`
-  /// (call before `f.finish()`): ConfigError for prior_epsilon ≤ 0, or a `prior_bias` or
-  /// `keep_prior_outside` without a `prior`.
+  /// Reads and checks `prior`, `prior_bias`, `prior_epsilon`, `keep_prior_outside` and
+  /// `prior_mix` from `f` (call before `f.finish()`): ConfigError for prior_epsilon ≤ 0, a
+  /// prior_mix outside [0, 1], or a `prior_bias`, `keep_prior_outside` or `prior_mix` > 0
+  /// without a `prior`.
   void read(config::Fields& f);
   /// The prior options of the model config node `model` (`{type: ..., prior: ..., ...}`; a
   /// model that reads no prior gives the defaults with an empty `prior`), checked as by read.

@@ -76,6 +76,7 @@ infer::ParameterFile parameter_file(const models::Model& model, const train::Run
     a["prior_bias"] = prior.prior_bias;
     a["prior_epsilon"] = prior.prior_epsilon;
     a["keep_prior_outside"] = prior.keep_prior_outside;
+    if (prior.prior_mix != 0) a["prior_mix"] = prior.prior_mix;
   }
   for (const auto& child : model.named_children()) {
     if (const auto* sequence = dynamic_cast<const graph::Sequence*>(child.value().get())) {

@@ -13,8 +13,8 @@
 /// model (graph/mlp.hpp) is listed under `mlps` by module path with its input width, widths and
 /// last activation. `top_k`, `distance_unit` and `min_distance` are the model's options
 /// (models/branched_model.hpp: HeterSkinNet's K and 1/D input, Sec. 3.2 and 4.2); a model
-/// reading a prior adds `prior`, `prior_bias`, `prior_epsilon` and `keep_prior_outside`
-/// (models::PriorOptions).
+/// reading a prior adds `prior`, `prior_bias`, `prior_epsilon` and `keep_prior_outside`, and
+/// `prior_mix` when it is not 0 (models::PriorOptions).
 
 #include <filesystem>
 #include <string>

@@ -56,7 +56,7 @@ Predictor Predictor::load(const fs::path& dir, const std::string& checkpoint) {
   const models::PriorOptions prior = models::PriorOptions::of(p.options_.model);
   p.preparation_ = infer::load_preparation(dir, p.options_.data.file, p.options_.data.distance,
                                            prior.prior);
-  p.prior_outside_ = prior.outside();
+  p.prior_use_ = {prior.prior, prior.keep_prior_outside, prior.prior_mix};
 
   p.model_ = train::build_model(p.options_);
   const train::TrainingState state = train::load_checkpoint(weights, *p.model_);
@@ -83,7 +83,7 @@ Prediction Predictor::predict(const geometry::Character& character, const Predic
   data::RowMatrixXf output = eval::to_eigen(candidates);
   if (times != nullptr) times->network += seconds_since(start);
   return infer::finish_prediction(std::move(input), distance(), std::move(output), options.prune,
-                                  prior_outside_, times);
+                                  prior_use_, times);
 }
 
 std::map<std::string, double> Predictor::metrics_of(const torch::Tensor& pred,

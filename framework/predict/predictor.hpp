@@ -97,9 +97,8 @@ class Predictor final : public infer::PredictEngine {
   infer::Preparation preparation_;  ///< the preprocessing and the one distance the model reads
   std::vector<std::shared_ptr<eval::Metric>> metrics_;
   std::string description_;
-  /// The prior whose weight off the candidates predictions keep (infer::keep_prior_outside);
-  /// empty: none
-  std::string prior_outside_;
+  /// What predictions do with the model's prior after the network (infer::use_prior)
+  infer::PriorUse prior_use_;
 };
 
 /// Makes the bundled model `out` (a new directory) from the run `run_dir` and its checkpoint

@@ -195,6 +195,41 @@ TEST(Prior, KeptOutsideTheCandidatesAZeroHeadGivesThePriorItself) {
                             {"keep_prior_outside", "prior"});
 }
 
+TEST(Prior, MixedWithTheModelsWeightsByAlpha) {
+  const data::PreparedCharacter ch = tube_with_bone_heat(2);
+  const data::RowMatrixXd P = ch.priors.at("bone_heat").cast<double>();
+  const Eigen::Index K = ch.distances.at("euclidean").topk_index.cols();
+  const data::RowMatrixXf uniform =
+      data::RowMatrixXf::Constant(P.rows(), K, 1.0f / static_cast<float>(K));
+  const data::RowMatrixXd model = scattered(uniform, ch, "euclidean");
+  ASSERT_GT((model - P).cwiseAbs().maxCoeff(), 0.1);  // the two differ, so the mix shows
+
+  for (const double alpha : {0.0, 0.25, 1.0}) {
+    data::RowMatrixXd W = model;
+    infer::mix_prior(W, ch, "bone_heat", alpha);
+    EXPECT_LT((W - ((1 - alpha) * model + alpha * P)).cwiseAbs().maxCoeff(), 1e-12) << alpha;
+    EXPECT_LT((W.rowwise().sum().array() - 1.0).abs().maxCoeff(), 1e-6) << alpha;
+  }
+  // use_prior keeps the prior off the candidates first, then mixes; nothing without a prior.
+  data::RowMatrixXd both = model, by_hand = model;
+  infer::use_prior(both, ch, "euclidean", {"bone_heat", true, 0.5});
+  infer::keep_prior_outside(by_hand, ch, "euclidean", "bone_heat");
+  infer::mix_prior(by_hand, ch, "bone_heat", 0.5);
+  EXPECT_LT((both - by_hand).cwiseAbs().maxCoeff(), 1e-12);
+  data::RowMatrixXd none = model;
+  infer::use_prior(none, ch, "euclidean", {"", true, 0.5});
+  EXPECT_EQ(none, model);
+
+  data::RowMatrixXd W = model;
+  expect_error<Error>([&] { infer::mix_prior(W, ch, "geo_voxel", 0.5); },
+                      {ch.name, "prior_mix", "'geo_voxel' prior", "preprocess.priors"});
+  expect_error<Error>([&] { infer::mix_prior(W, ch, "bone_heat", 1.5); },
+                      {ch.name, "prior_mix", "[0, 1]", "1.5"});
+  expect_error<ConfigError>([&] { make_model("prior_mix: 0.5, "); }, {"prior_mix", "prior"});
+  expect_error<ConfigError>([&] { make_model("prior: bone_heat, prior_mix: -0.1, "); },
+                            {"prior_mix", "[0, 1]"});
+}
+
 TEST(Prior, AModelReadingAPriorTheCharacterLacksNamesBoth) {
   const auto model = make_model("prior: bone_heat, ");
   const data::CharacterTensors c = data::to_tensors(testing::prepared_tube(0), "euclidean");
@@ -283,15 +318,19 @@ TEST(Prior, TrainsAndPredictsWithTheRunsPreparationInLibtorchAndEigen) {
   d.splits["random"] = {{0, 1}, {2}, {}};
   d.preparation = std::string("preprocess: ") + kPreprocess + "\ndistances: [{type: euclidean}]\n";
   data::write_dataset(dir / "tubes.h5", d);
-  const config::Config config = config::Config::parse(
-      "experiment: prior\nseed: 3\nresults_dir: " + (dir / "results").string() +
-      "\nmodel: " + tiny_heterskinnet("prior: bone_heat, keep_prior_outside: true, ") +
-      // the anchor to the prior (losses/prior_kl.hpp) runs through training and validation too
-      "\nlosses: [{type: soft_cross_entropy, weight: 1.0}, {type: prior_kl, prior: bone_heat, "
-      "weight: 0.5}]\n"
-      "metrics: [{type: avg_l1, prune: 0}]\n"
-      "data: {file: " + (dir / "tubes.h5").string() + ", split: random, distance: euclidean}\n"
-      "train: {epochs: 2, lr: 1.0e-3, patience: 0, log_every: 0}\n");
+  // The run's config, with `extra` model fields.
+  const auto run_config = [&](const std::string& extra) {
+    return config::Config::parse(
+        "experiment: prior\nseed: 3\nresults_dir: " + (dir / "results").string() +
+        "\nmodel: " + tiny_heterskinnet("prior: bone_heat, keep_prior_outside: true, " + extra) +
+        // the anchor to the prior (losses/prior_kl.hpp) runs through training and validation too
+        "\nlosses: [{type: soft_cross_entropy, weight: 1.0}, {type: prior_kl, prior: bone_heat, "
+        "weight: 0.5}]\n"
+        "metrics: [{type: avg_l1, prune: 0}]\n"
+        "data: {file: " + (dir / "tubes.h5").string() + ", split: random, distance: euclidean}\n"
+        "train: {epochs: 2, lr: 1.0e-3, patience: 0, log_every: 0}\n");
+  };
+  const config::Config config = run_config("");
   train::Trainer trainer(config);
   const RunDir run = train::create_run(config, trainer.options(), "p", {"test"});
   trainer.fit(run);
@@ -336,6 +375,34 @@ TEST(Prior, TrainsAndPredictsWithTheRunsPreparationInLibtorchAndEigen) {
       eval::evaluate(run, {"val", "best", false, {"model.keep_prior_outside=false"}});
   EXPECT_DOUBLE_EQ(kept.mean.at("loss"), dropped.mean.at("loss"));
   EXPECT_GT(std::abs(kept.mean.at("avg_l1") - dropped.mean.at("avg_l1")), 1e-4);
+
+  // prior_mix: the same checkpoint under `prior_mix: 0.25` predicts 0.75·(the weights above) +
+  // 0.25·(the prior) in libtorch, in the Eigen forward pass (its parameter file records α) and
+  // in evaluation, whose loss is still the network's own.
+  const config::Config mixed_config = run_config("prior_mix: 0.25, ");
+  const RunDir mixed =
+      train::create_run(mixed_config, train::RunOptions::from(mixed_config), "q", {"test"});
+  fs::copy_file(train::checkpoint_file(run.path(), "best"),
+                train::checkpoint_file(mixed.path(), "best"));
+  const predict::Predictor mixed_predictor = predict::Predictor::load(mixed.path());
+  mixed_predictor.write_parameters(mixed.path() / "parameters.h5");
+  EXPECT_DOUBLE_EQ(
+      infer::read_parameter_file(mixed.path() / "parameters.h5").architecture.at("prior_mix"),
+      0.25);
+  EXPECT_FALSE(file.architecture.contains("prior_mix"));  // written only when not 0
+  const predict::Prediction pm = mixed_predictor.predict(testing::tube_character(5).character,
+                                                         unpruned);
+  const predict::Prediction em = infer::EigenPredictor::load(mixed.path())
+                                     .predict(testing::tube_character(5).character, unpruned);
+  const data::RowMatrixXd expected =
+      0.75 * completed + 0.25 * p0.prepared.priors.at("bone_heat").cast<double>();
+  EXPECT_LE((pm.prepared_weights.cast<double>() - expected).cwiseAbs().maxCoeff(), 1e-6);
+  EXPECT_LE((em.prepared_weights - pm.prepared_weights).cwiseAbs().maxCoeff(), 1e-5);
+  EXPECT_GT((expected - completed).cwiseAbs().maxCoeff(), 1e-3);
+  const eval::EvalReport mixed_eval =
+      eval::evaluate(run, {"val", "best", false, {"model.prior_mix=0.25"}});
+  EXPECT_DOUBLE_EQ(kept.mean.at("loss"), mixed_eval.mean.at("loss"));
+  EXPECT_GT(std::abs(kept.mean.at("avg_l1") - mixed_eval.mean.at("avg_l1")), 1e-4);
   // The prior moves the answer: the same network with a zero prior gives other weights.
   data::PreparedCharacter without = e.prepared;
   without.priors.at("bone_heat").setZero();
