@@ -418,7 +418,7 @@ train::TrainResult SequenceTrainer::fit(const RunDir& run, const train::FitLimit
       break;
     }
   }
-  train::finish_fit(result, state, t, train::stopped_early(state, t), start);
+  train::finish_fit(result, state, t, start);
   return result;
 }
 

@@ -292,7 +292,7 @@ train::TrainResult CorrectiveTrainer::fit(const RunDir& run, const train::FitLim
       break;
     }
   }
-  train::finish_fit(result, state, t, train::stopped_early(state, t), start);
+  train::finish_fit(result, state, t, start);
   return result;
 }
 

@@ -91,8 +91,8 @@ bool record_epoch(TrainingState& state, std::int64_t epoch, double selection, do
 }
 
 void finish_fit(TrainResult& result, const TrainingState& state, const TrainOptions& options,
-                bool stopped_early, std::chrono::steady_clock::time_point start) {
-  result.early_stopped = stopped_early && state.epoch < options.epochs;
+                std::chrono::steady_clock::time_point start) {
+  result.early_stopped = stopped_early(state, options) && state.epoch < options.epochs;
   if (result.early_stopped && !result.interrupted) {
     spdlog::info("early stopping after epoch {}: no improvement for {} epochs (best epoch {})",
                  state.epoch, options.patience, state.best_epoch);
@@ -141,7 +141,8 @@ FitStart start_fit(const RunDir& run, torch::nn::Module& model, torch::optim::Op
     set_rng_state(torch_rng, saved.torch_rng);
     set_rng_state(order_rng, saved.order_rng);
     start.resumed = true;
-    if (writer && !finished(state, options)) {
+    const bool done = finished(state, options);
+    if (writer && !done) {
       const GitState& git = build_git_state();
       run.record_resume({{"after_epoch", state.epoch},
                          {"git_commit", git.commit},
@@ -151,7 +152,7 @@ FitStart start_fit(const RunDir& run, torch::nn::Module& model, torch::optim::Op
     }
     spdlog::info("resuming {} after epoch {} (best epoch {}, loss {:.6g})", run.path().string(),
                  state.epoch, state.best_epoch, state.best_loss);
-    if (writer && finished(state, options)) {
+    if (writer && done) {
       spdlog::info("nothing to train: the run has finished ({} epochs{})", state.epoch,
                    stopped_early(state, options) ? ", stopped early" : "");
     }

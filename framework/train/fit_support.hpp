@@ -77,9 +77,10 @@ FitStart start_fit(const RunDir& run, torch::nn::Module& model, torch::optim::Op
                    at::Generator& order_rng, const torch::Tensor& initial_torch_rng,
                    bool writer = true);
 
-/// The end of a fit: sets `result`'s early_stopped (logging it unless the fit was interrupted),
-/// epochs, best epoch and loss from the final `state`, and the wall time since `start`.
+/// The end of a fit: sets `result`'s early_stopped (stopped_early before `options.epochs`;
+/// logged unless the fit was interrupted), epochs, best epoch and loss from the final `state`,
+/// and the wall time since `start`.
 void finish_fit(TrainResult& result, const TrainingState& state, const TrainOptions& options,
-                bool stopped_early, std::chrono::steady_clock::time_point start);
+                std::chrono::steady_clock::time_point start);
 
 }  // namespace skinlab::train

@@ -310,7 +310,7 @@ TrainResult Trainer::fit(const RunDir& run, const FitLimits& limits) {
       break;
     }
   }
-  finish_fit(result, state, t, stopped_early(state, t), start);
+  finish_fit(result, state, t, start);
   return result;
 }
 
