@@ -137,10 +137,10 @@ void keep_prior_outside(data::RowMatrixXd& W, const data::PreparedCharacter& cha
 /// A model's bone weights mixed with a prior's (models::PriorOptions::prior_mix; not in the
 /// papers): W ← (1 − α)·W + α·P for `character`'s prior `prior` P (#V×#B, as W), α = `alpha`
 /// in [0, 1]. Rows that sum to 1 still do. A convex combination of the learned weights and the
-/// classical method's, chosen on characters from sources the network did not train on: where
-/// the network has not seen a source, it errs differently from the prior, and the mix errs less
-/// than either. Throws Error naming the character when it has no such prior or its shape
-/// differs.
+/// classical method's, for characters from sources the network did not train on, where the two
+/// err differently and the mix can err less than either (α is chosen on such sources;
+/// experiments/heterskinnet/README.md measures where it does). Throws Error naming the character
+/// when it has no such prior or its shape differs, or for α outside [0, 1].
 void mix_prior(data::RowMatrixXd& W, const data::PreparedCharacter& character,
                const std::string& prior, double alpha);
 
@@ -162,8 +162,8 @@ void use_prior(data::RowMatrixXd& W, const data::PreparedCharacter& character,
 
 /// Step 4: `candidates` (#V×K, the network's softmax over `input.prepared`'s candidates of
 /// `distance`) scattered to bones, completed with the model's prior as `prior` says (use_prior),
-/// pruned, checked (every vertex keeps a weight)
-/// and mapped back to the input's vertices and joints; `input.prepared` moves into the result.
+/// pruned, checked (every vertex keeps a weight) and mapped back to the input's vertices and
+/// joints; `input.prepared` moves into the result.
 /// Throws Error naming the character and the vertex for a non-finite or negative output or a
 /// vertex left without weight. `times->map_back` receives the mapping back.
 Prediction finish_prediction(PreparedInput input, const std::string& distance,
