@@ -14,8 +14,8 @@
 /// where the file system allows, else a copy), so `skinlab table` compares it with its source
 /// like any two runs. For settings that act after training only
 /// (models::BranchedModelOptions::leaf_bias, models::PriorOptions::keep_prior_outside and
-/// prior_mix, the metrics' pruning, another dataset file); an override under which the checkpoint does not load is an error before the
-/// directory is made.
+/// prior_mix, the metrics' pruning, another dataset file); an override under which the
+/// checkpoint does not load is an error before the directory is made.
 ///
 /// `--nproc N` shards the characters of a skinning run over N worker processes on this machine
 /// (core/launch.hpp); rank 0 gathers the values and predictions and writes the files. A process
